@@ -1,0 +1,31 @@
+"""``stickslip simulate``: run one solver on parameters given as KEY=VALUE."""
+
+from pathlib import Path
+
+from .. import registry
+from ..numba_options import set_num_threads
+from ..params import parse_assignments, parse_params
+
+
+def add_parser(subparsers):
+    """Add the ``simulate`` sub-command."""
+    parser = subparsers.add_parser(
+        "simulate", help="run one simulation",
+        description="Run one solver plugin and write its output file. "
+                    "`stickslip plugins --params` lists every solver parameter with its default.")
+    parser.add_argument("--solver", required=True, help="solver plugin name (see `stickslip plugins`)")
+    parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                        help="one parameter (repeat); the others keep their defaults")
+    parser.add_argument("--threads", type=int, default=1, help="threads for parallel kernels (default 1)")
+    parser.add_argument("-o", "--output", required=True, type=Path, help="output file (HDF5)")
+    parser.set_defaults(func=run)
+
+
+def run(args):
+    """Validate the parameters, then run the solver."""
+    plugin = registry.get("solver", args.solver)
+    params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
+    threads = set_num_threads(args.threads)
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    plugin.run(params, args.output, threads=threads)
+    return 0

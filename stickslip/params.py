@@ -1,0 +1,283 @@
+"""Plugin parameters: typed dataclasses that give defaults, validation and docs.
+
+Every plugin declares one frozen dataclass whose fields all have defaults and
+are made with :func:`param`. That one declaration feeds:
+
+- :func:`parse_params`: a mapping (config section, ``KEY=VALUE`` strings) to a
+  validated instance, with errors that name the field and what was expected;
+- :func:`params_to_dict`: the defaults-filled, JSON-safe form used for run ids,
+  provenance records and HDF5 attributes;
+- :func:`json_schema`: the JSON-Schema of the section in the workflow config;
+- :func:`describe`: the rows of ``stickslip plugins --params``.
+
+Supported field types: ``int``, ``float``, ``bool``, ``str`` and tuples
+``tuple[int, ...]``, ``tuple[float, ...]`` (written ``1,2,3`` on a command line).
+A dataclass may define ``check(self)``, called after the per-field checks, for
+conditions that involve several fields; it raises :class:`ParameterError`.
+"""
+
+import dataclasses
+import math
+import typing
+from collections.abc import Iterable, Mapping
+
+__all__ = [
+    "ParameterError",
+    "param",
+    "parse_params",
+    "parse_assignments",
+    "params_to_dict",
+    "json_schema",
+    "describe",
+]
+
+
+class ParameterError(ValueError):
+    """A parameter name or value is not acceptable; the message says which and why."""
+
+
+def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, exclusive_minimum=None):
+    """Declare one plugin parameter.
+
+    Parameters
+    ----------
+    default
+        Default value (immutable: tuples, not lists).
+    doc : str
+        One-line description, shown by ``stickslip plugins --params``.
+    unit : str, optional
+        Physical unit ("" for dimensionless or not applicable).
+    choices : sequence, optional
+        The allowed values.
+    minimum, maximum : float, optional
+        Inclusive bounds (for tuples: of every element).
+    exclusive_minimum : float, optional
+        Exclusive lower bound (for tuples: of every element).
+
+    Returns
+    -------
+    dataclasses.Field
+    """
+    meta = {"doc": doc, "unit": unit, "choices": tuple(choices) if choices is not None else None,
+            "minimum": minimum, "maximum": maximum, "exclusive_minimum": exclusive_minimum}
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def _field_types(cls):
+    hints = typing.get_type_hints(cls)
+    return {f.name: hints[f.name] for f in dataclasses.fields(cls)}
+
+
+def _element_type(annotation):
+    """Return (is_tuple, scalar type) of a supported annotation."""
+    if typing.get_origin(annotation) is tuple:
+        args = typing.get_args(annotation)
+        if len(args) != 2 or args[1] is not Ellipsis or args[0] not in (int, float):
+            raise TypeError(f"unsupported parameter type {annotation!r}")
+        return True, args[0]
+    if annotation not in (int, float, bool, str):
+        raise TypeError(f"unsupported parameter type {annotation!r}")
+    return False, annotation
+
+
+_TRUE = {"true", "yes", "1", "on"}
+_FALSE = {"false", "no", "0", "off"}
+
+
+def _convert_scalar(name, value, kind):
+    expected = {int: "an integer", float: "a number", bool: "true or false", str: "a string"}[kind]
+    if kind is bool:
+        if isinstance(value, bool):
+            return value
+        if isinstance(value, str) and value.strip().lower() in _TRUE | _FALSE:
+            return value.strip().lower() in _TRUE
+        raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
+    if kind is str:
+        if isinstance(value, str):
+            return value
+        raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
+    if isinstance(value, bool):
+        raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
+    try:
+        if kind is int:
+            if isinstance(value, float):
+                if not value.is_integer():
+                    raise ValueError
+                return int(value)
+            return int(str(value).strip()) if isinstance(value, str) else int(value)
+        converted = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}") from None
+    if not math.isfinite(converted):
+        raise ParameterError(f"parameter '{name}': expected a finite number, got {value!r}")
+    return converted
+
+
+def _check_bounds(name, value, meta):
+    if meta["choices"] is not None and value not in meta["choices"]:
+        allowed = ", ".join(repr(c) for c in meta["choices"])
+        raise ParameterError(f"parameter '{name}': {value!r} is not allowed; expected one of {allowed}")
+    if meta["minimum"] is not None and value < meta["minimum"]:
+        raise ParameterError(f"parameter '{name}': expected a value >= {meta['minimum']}, got {value!r}")
+    if meta["maximum"] is not None and value > meta["maximum"]:
+        raise ParameterError(f"parameter '{name}': expected a value <= {meta['maximum']}, got {value!r}")
+    if meta["exclusive_minimum"] is not None and value <= meta["exclusive_minimum"]:
+        raise ParameterError(
+            f"parameter '{name}': expected a value > {meta['exclusive_minimum']}, got {value!r}")
+
+
+def _convert(name, value, annotation, meta):
+    is_tuple, kind = _element_type(annotation)
+    if not is_tuple:
+        converted = _convert_scalar(name, value, kind)
+        _check_bounds(name, converted, meta)
+        return converted
+    if isinstance(value, str):
+        items = [item for item in value.split(",") if item.strip()]
+    elif isinstance(value, Iterable):
+        items = list(value)
+    else:
+        items = [value]
+    converted = tuple(_convert_scalar(name, item, kind) for item in items)
+    for item in converted:
+        _check_bounds(name, item, meta)
+    return converted
+
+
+def parse_params(cls, values=None, *, owner=""):
+    """Build a validated parameter instance from a mapping, filling defaults.
+
+    Parameters
+    ----------
+    cls : type
+        A parameter dataclass made with :func:`param` fields.
+    values : Mapping[str, object], optional
+        Values by field name; strings are converted to the field's type.
+    owner : str, optional
+        Name of the plugin, used in error messages (e.g. "solver 'fem'").
+
+    Returns
+    -------
+    object
+        An instance of ``cls``.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown name (the message lists the allowed names), a value of the
+        wrong type or out of range (the message names the field and the expectation),
+        or a failed ``check()``.
+    """
+    values = dict(values or {})
+    types = _field_types(cls)
+    unknown = sorted(set(values) - set(types))
+    if unknown:
+        where = f" of {owner}" if owner else ""
+        raise ParameterError(
+            f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}{where}; "
+            f"allowed: {', '.join(types)}")
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name in values:
+            kwargs[f.name] = _convert(f.name, values[f.name], types[f.name], f.metadata)
+    instance = cls(**kwargs)
+    check = getattr(instance, "check", None)
+    if check is not None:
+        check()
+    return instance
+
+
+def parse_assignments(assignments):
+    """Split ``KEY=VALUE`` strings into a mapping (values stay strings).
+
+    Parameters
+    ----------
+    assignments : Iterable[str]
+
+    Returns
+    -------
+    dict[str, str]
+
+    Raises
+    ------
+    ParameterError
+        If an item has no ``=`` or an empty key, or a key is given twice.
+    """
+    values = {}
+    for item in assignments or ():
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ParameterError(f"expected KEY=VALUE, got {item!r}")
+        if key in values:
+            raise ParameterError(f"parameter '{key}' is given twice")
+        values[key] = value.strip()
+    return values
+
+
+def params_to_dict(instance):
+    """Return the parameters as a JSON-safe dict (tuples become lists), in field order."""
+    return {f.name: list(v) if isinstance(v := getattr(instance, f.name), tuple) else v
+            for f in dataclasses.fields(instance)}
+
+
+_JSON_TYPES = {int: "integer", float: "number", bool: "boolean", str: "string"}
+
+
+def json_schema(cls):
+    """Return the JSON-Schema (as a dict) of a parameter dataclass, with defaults.
+
+    Parameters
+    ----------
+    cls : type
+        A parameter dataclass.
+
+    Returns
+    -------
+    dict
+        ``{"type": "object", "properties": ..., "additionalProperties": False}``.
+    """
+    properties = {}
+    for f in dataclasses.fields(cls):
+        annotation = _field_types(cls)[f.name]
+        is_tuple, kind = _element_type(annotation)
+        scalar = {"type": _JSON_TYPES[kind]}
+        meta = f.metadata
+        if meta.get("choices") is not None:
+            scalar["enum"] = list(meta["choices"])
+        for key in ("minimum", "maximum"):
+            if meta.get(key) is not None:
+                scalar[key] = meta[key]
+        if meta.get("exclusive_minimum") is not None:
+            scalar["exclusiveMinimum"] = meta["exclusive_minimum"]
+        prop = {"type": "array", "items": scalar} if is_tuple else scalar
+        prop["default"] = list(f.default) if is_tuple else f.default
+        unit = f" [{meta['unit']}]" if meta.get("unit") else ""
+        prop["description"] = meta.get("doc", "") + unit
+        properties[f.name] = prop
+    return {"type": "object", "properties": properties, "additionalProperties": False}
+
+
+def describe(cls):
+    """Return one row per parameter: (name, type, default, unit, doc).
+
+    Parameters
+    ----------
+    cls : type
+        A parameter dataclass.
+
+    Returns
+    -------
+    list[tuple[str, str, object, str, str]]
+    """
+    rows = []
+    for f in dataclasses.fields(cls):
+        annotation = _field_types(cls)[f.name]
+        type_name = getattr(annotation, "__name__", str(annotation))
+        if typing.get_origin(annotation) is tuple:
+            type_name = f"tuple[{typing.get_args(annotation)[0].__name__}]"
+        doc = f.metadata.get("doc", "")
+        if f.metadata.get("choices") is not None:
+            doc += f" (one of: {', '.join(map(str, f.metadata['choices']))})"
+        rows.append((f.name, type_name, f.default, f.metadata.get("unit", ""), doc))
+    return rows
