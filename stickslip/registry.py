@@ -15,8 +15,11 @@ of the plugin's kind (:data:`ENTRY_POINT_GROUPS`) that names the module to impor
 
 Call signatures by kind (checked when a plugin registers):
 
-- ``solver``: ``run(params, output, *, threads)``: write one simulation file
-  ``output`` (:class:`pathlib.Path`, HDF5) using at most ``threads`` threads.
+- ``solver``: ``run(params, output, *, threads, inputs)``: write one simulation
+  file ``output`` (:class:`pathlib.Path`, HDF5) using at most ``threads``
+  threads; ``inputs`` maps each declared input category (e.g. ``"mesh"``) to a
+  path made by an upstream stage, and may be empty (the solver then makes what
+  it needs itself).
 - ``analysis``: ``run(params, input, output)``: read one solver output, write one
   HDF5 table file.
 - ``figure``: ``run(params, inputs, output)``: ``inputs`` maps each declared input
@@ -54,7 +57,7 @@ ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.anal
 BUILTIN_MODULES = ()
 
 _RUN_SIGNATURES = {
-    "solver": (["params", "output"], ["threads"]),
+    "solver": (["params", "output"], ["threads", "inputs"]),
     "analysis": (["params", "input", "output"], []),
     "figure": (["params", "inputs", "output"], []),
 }
@@ -88,8 +91,11 @@ class Plugin:
     summary : str
         One line for ``stickslip plugins``.
     inputs : tuple[str, ...]
-        Input categories (analyses: the solver outputs it accepts, by solver name;
-        figures: the workflow categories it reads).
+        Input categories. Solvers: optional upstream files (``"mesh"``).
+        Analyses: the solver names whose outputs it accepts. Figures: what it
+        reads, each ``"solver:<name>"`` (all outputs of that solver in the
+        study), ``"analysis:<name>"`` (all outputs of that analysis) or
+        ``"mesh"`` (all mesh files).
     module : str
         Module that defined it.
     """

@@ -15,7 +15,7 @@ class Params:
 
 def test_malformed_plugins_are_refused():
     with pytest.raises(registry.PluginError, match="path component"):
-        registry.register("solver", "Bad Name", "1", Params)(lambda params, output, *, threads: None)
+        registry.register("solver", "Bad Name", "1", Params)(lambda params, output, *, threads, inputs: None)
     with pytest.raises(registry.PluginError, match="signature"):
         registry.register("solver", "test-wrong-signature", "1", Params)(lambda params, out: None)
     with pytest.raises(registry.PluginError, match="dataclass"):
@@ -30,7 +30,7 @@ def test_malformed_plugins_are_refused():
 
 
 def test_register_get_and_run_id():
-    def solve(params, output, *, threads):
+    def solve(params, output, *, threads, inputs):
         """Test solver."""
 
     registry.register("solver", "test-solver", "1.0", Params)(solve)
@@ -41,6 +41,6 @@ def test_register_get_and_run_id():
     assert a == registry.run_id(plugin, parse_params(Params, {}))  # defaults filled: same id
     assert a != registry.run_id(plugin, parse_params(Params, {"x": 2}))
     with pytest.raises(registry.PluginError, match="already registered"):
-        registry.register("solver", "test-solver", "1.0", Params)(lambda params, output, *, threads: None)
+        registry.register("solver", "test-solver", "1.0", Params)(lambda params, output, *, threads, inputs: None)
     with pytest.raises(registry.PluginError, match="unknown solver 'nope'"):
         registry.get("solver", "nope")

@@ -27,5 +27,5 @@ def run(args):
     params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
     threads = set_num_threads(args.threads)
     args.output.parent.mkdir(parents=True, exist_ok=True)
-    plugin.run(params, args.output, threads=threads)
+    plugin.run(params, args.output, threads=threads, inputs={})
     return 0
