@@ -1,0 +1,207 @@
+"""Slip detection on slab positions and the amplitudes of the detected slips.
+
+Detection follows the paper's appendix "Slow slip" exactly:
+
+1. velocity of each interface from frame differences, ``v_k = (R_{k+1} - R_k) / (t_{k+1} - t_k)``;
+2. a centred running average over five frames;
+3. a slip is every cluster of at least three consecutive frames with smoothed velocity above
+   ``0.02 mm/s``.
+
+A cluster ``[k0, k1]`` of smoothed velocities involves the raw velocities ``k0 - w .. k1 + w``
+(``w = 2``, half the averaging width), that is the frames ``k0 - w .. k1 + w + 1``: the slip lies
+between those two frames, which bracket it (``t_start``, ``t_end``) and give ``dR`` as the
+difference of the positions there. Clusters of different interfaces whose brackets overlap form
+one *event* with several slipping interfaces: it is flagged ``multi`` and never assigned to one
+interface.
+
+The lever force drop of an event is measured on the force signal outside the bracket, see
+:func:`force_drop`.
+"""
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["VELOCITY_THRESHOLD", "AVERAGE_FRAMES", "MIN_FRAMES", "frame_velocity", "running_average",
+           "clusters", "detect_slips", "force_drop"]
+
+#: Velocity above which a frame belongs to a slip [mm/s] (paper, appendix "Slow slip").
+VELOCITY_THRESHOLD = 0.02
+#: Width of the running average of the velocity [frames].
+AVERAGE_FRAMES = 5
+#: Minimum length of a cluster of fast frames [frames].
+MIN_FRAMES = 3
+
+
+def frame_velocity(t_x, R):
+    """Velocity of every interface from frame differences.
+
+    Parameters
+    ----------
+    t_x : numpy.ndarray, shape (n_frames,)
+        Frame times [s], strictly increasing.
+    R : numpy.ndarray, shape (n_frames, n_slabs)
+        Relative positions ``R_i = x_i - x_{i-1}`` [mm].
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_frames - 1, n_slabs)
+        ``(R[k+1] - R[k]) / (t_x[k+1] - t_x[k])`` [mm/s].
+    """
+    return np.diff(R, axis=0) / np.diff(t_x)[:, None]
+
+
+def running_average(values, width=AVERAGE_FRAMES):
+    """Centred running average along the first axis; NaN where the window is incomplete.
+
+    Parameters
+    ----------
+    values : numpy.ndarray, shape (m, ...)
+    width : int
+        Odd window length [samples].
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, ...)
+        ``out[k] = mean(values[k - width//2 : k + width//2 + 1])``; the first and last
+        ``width // 2`` entries are NaN.
+    """
+    if width < 1 or width % 2 == 0:
+        raise ValueError(f"running-average width must be a positive odd number, got {width}")
+    values = np.asarray(values, dtype=float)
+    half = width // 2
+    out = np.full(values.shape, np.nan)
+    if values.shape[0] < width:
+        return out
+    cumulative = np.concatenate([np.zeros((1,) + values.shape[1:]), np.cumsum(values, axis=0)])
+    out[half:values.shape[0] - half] = (cumulative[width:] - cumulative[:-width]) / width
+    return out
+
+
+def clusters(mask, min_length=MIN_FRAMES):
+    """First and last index of every run of consecutive True values of at least ``min_length``.
+
+    Parameters
+    ----------
+    mask : numpy.ndarray of bool, shape (m,)
+    min_length : int
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (n_clusters, 2)
+        Inclusive ``[first, last]`` per run, in increasing order.
+    """
+    padded = np.concatenate([[0], np.asarray(mask, dtype=np.int8), [0]])
+    change = np.diff(padded)
+    first = np.flatnonzero(change == 1)
+    last = np.flatnonzero(change == -1) - 1
+    keep = last - first + 1 >= min_length
+    return np.column_stack([first[keep], last[keep]])
+
+
+def detect_slips(t_x, R, *, threshold=VELOCITY_THRESHOLD, width=AVERAGE_FRAMES, min_frames=MIN_FRAMES):
+    """Detect slips on every interface and group simultaneous ones into events.
+
+    Parameters
+    ----------
+    t_x : numpy.ndarray, shape (n_frames,)
+        Frame times [s].
+    R : numpy.ndarray, shape (n_frames, n_slabs)
+        Relative positions [mm]; column ``i - 1`` is interface ``i``.
+    threshold : float
+        Smoothed velocity above which a frame is fast [mm/s].
+    width : int
+        Running-average width [frames] (odd).
+    min_frames : int
+        Minimum number of consecutive fast frames of a slip.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per slip, sorted by ``t_start`` then ``a``, columns:
+
+        - ``event`` (int): event number; the slips of one event have brackets that overlap;
+        - ``a`` (int): slipping interface (1 = lowest);
+        - ``multi`` (bool): the event has more than one slipping interface;
+        - ``i_start``, ``i_end`` (int): frames that bracket the slip;
+        - ``t_start``, ``t_end`` [s]: their times;
+        - ``t`` [s]: middle of the frame interval with the largest displacement of ``R_a``;
+        - ``dR`` [mm]: ``R_a[i_end] - R_a[i_start]``.
+    """
+    t_x = np.asarray(t_x, dtype=float)
+    R = np.asarray(R, dtype=float)
+    velocity = frame_velocity(t_x, R)
+    smooth = running_average(velocity, width)
+    half = width // 2
+    rows = []
+    for column in range(R.shape[1]):
+        fast = np.nan_to_num(smooth[:, column], nan=-np.inf) > threshold
+        for k0, k1 in clusters(fast, min_frames):
+            i_start = k0 - half
+            i_end = k1 + half + 1
+            step = i_start + int(np.argmax(np.diff(R[i_start:i_end + 1, column])))
+            rows.append((column + 1, i_start, i_end, t_x[i_start], t_x[i_end],
+                         0.5 * (t_x[step] + t_x[step + 1]), R[i_end, column] - R[i_start, column]))
+    slips = pd.DataFrame(rows, columns=["a", "i_start", "i_end", "t_start", "t_end", "t", "dR"])
+    slips = slips.sort_values(["i_start", "a"], kind="stable").reset_index(drop=True)
+    # Overlapping brackets (on different interfaces) make one event.
+    reach = np.maximum.accumulate(slips["i_end"].to_numpy()) if len(slips) else np.zeros(0, int)
+    new_event = np.ones(len(slips), dtype=bool)
+    new_event[1:] = slips["i_start"].to_numpy()[1:] > reach[:-1]
+    slips.insert(0, "event", np.cumsum(new_event) - 1)
+    size = slips.groupby("event")["a"].transform("size").to_numpy()
+    slips.insert(2, "multi", size > 1)
+    return slips.astype({"event": int, "a": int, "i_start": int, "i_end": int})
+
+
+def force_drop(t_F, F, t_start, t_end, *, window, t_previous=None, t_next=None):
+    """Lever force drop across slip windows, robust to sensor noise and to the loading ramp.
+
+    For each slip, two straight lines with one common slope are fitted (least squares) to
+    ``F`` on the window before, ``[max(t_start - window, t_previous), t_start]``, and after,
+    ``[t_end, min(t_end + window, t_next)]``. The drop is their vertical distance::
+
+        dF = mean(F_before) - mean(F_after) + r (mean(t_after) - mean(t_before)),
+
+    with ``r`` the common slope: the two means average out the noise, and the slope term removes
+    the load added by the drive between the two windows (without it, ``dF`` would be biased low by
+    about ``r (t_end - t_start + window)``). The loading rate is measured locally, so the estimate
+    needs no model of the drive and stays valid with creep.
+
+    Parameters
+    ----------
+    t_F : numpy.ndarray, shape (n_F,)
+        Force sample times [s], increasing.
+    F : numpy.ndarray, shape (n_F,)
+        Lever force [N].
+    t_start, t_end : numpy.ndarray, shape (n_slips,)
+        Slip brackets [s].
+    window : float
+        Length of the fit windows [s].
+    t_previous, t_next : numpy.ndarray, shape (n_slips,), optional
+        End of the previous and start of the next slip [s]: the windows stop there.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_slips,)
+        ``dF`` [N]; NaN where a window holds fewer than two samples.
+    """
+    t_start = np.atleast_1d(np.asarray(t_start, dtype=float))
+    t_end = np.atleast_1d(np.asarray(t_end, dtype=float))
+    lower = t_start - window if t_previous is None else np.maximum(t_start - window, t_previous)
+    upper = t_end + window if t_next is None else np.minimum(t_end + window, t_next)
+    b0 = np.searchsorted(t_F, lower, side="left")
+    b1 = np.searchsorted(t_F, t_start, side="right")
+    a0 = np.searchsorted(t_F, t_end, side="left")
+    a1 = np.searchsorted(t_F, upper, side="right")
+    drop = np.full(t_start.shape, np.nan)
+    for index in range(t_start.size):
+        before = slice(b0[index], b1[index])
+        after = slice(a0[index], a1[index])
+        if b1[index] - b0[index] < 2 or a1[index] - a0[index] < 2:
+            continue
+        tb, fb, ta, fa = t_F[before], F[before], t_F[after], F[after]
+        tb_mean, ta_mean = tb.mean(), ta.mean()
+        spread = np.sum((tb - tb_mean) ** 2) + np.sum((ta - ta_mean) ** 2)
+        slope = (np.sum((tb - tb_mean) * (fb - fb.mean())) + np.sum((ta - ta_mean) * (fa - fa.mean()))) / spread
+        drop[index] = fb.mean() - fa.mean() + slope * (ta_mean - tb_mean)
+    return drop
