@@ -302,8 +302,8 @@ def slip_sequences(slips):
     """
     single = slips["single"].to_numpy(dtype=bool)
     increment = slips["increment"].to_numpy()
-    starts = np.flatnonzero(np.r_[True, single[1:] != single[:-1]]) if single.size else np.array([], dtype=int)
-    ends = np.r_[starts[1:], single.size] - 1
+    starts = np.flatnonzero(np.r_[True, single[1:] != single[:-1]])[:single.size]
+    ends = np.r_[starts[1:], single.size][:starts.size] - 1
     return pd.DataFrame({
         "first_increment": increment[starts],
         "last_increment": increment[ends],

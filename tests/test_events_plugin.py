@@ -1,0 +1,70 @@
+"""The numerical-events plugin's output file: tables, attributes, reproducible bytes."""
+
+import numpy as np
+import pytest
+
+from stickslip import registry
+from stickslip.events import extraction, plugin, results
+from stickslip.h5io import FileFormatError
+from test_events_extraction import EVENTS, N, history
+
+RUN_ATTRS = {"N": N, "plates": 3, "n_interfaces": 2, "k_drive": 1e-6, "seed": 4, "eps0": 5e-5, "c_s": 0.7071}
+
+
+def write(path, events=EVENTS, attrs=RUN_ATTRS):
+    tables = plugin.event_tables(history(N, events), N)
+    plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path)
+    return tables
+
+
+def test_event_file_round_trip(tmp_path):
+    tables = write(tmp_path / "events.h5")
+    read = results.read_analysis_file(tmp_path / "events.h5", ("increments", "slips", "slip_interfaces", "sequences"))
+    assert read.n == 2 and read.regime == "compliant"
+    assert read.attrs["N"] == N and read.attrs["seed"] == 4 and read.attrs["steady_state"] == 8
+    assert read.attrs["analysis"] == "numerical-events"
+    for name, table in tables.items():
+        assert list(read.tables[name].columns) == list(table.columns)
+        for column in table.columns:
+            expected, got = table[column].to_numpy(), read.tables[name][column].to_numpy()
+            if expected.dtype.kind == "f":
+                np.testing.assert_array_equal(got, expected)
+            else:
+                assert got.tolist() == expected.tolist()
+    np.testing.assert_allclose(extraction.slip_fractions(read.tables["slips"], 2), [4 / 7, 3 / 7])
+
+
+def test_same_input_same_bytes(tmp_path):
+    write(tmp_path / "a.h5")
+    write(tmp_path / "b.h5")
+    assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
+
+
+def test_run_without_steady_state_gives_empty_slip_tables(tmp_path):
+    write(tmp_path / "e.h5", events=[((3, 0), (0.0, 0.0))] * 4)
+    read = results.read_analysis_file(tmp_path / "e.h5", ("slips", "sequences", "slip_interfaces"))
+    assert read.attrs["steady_state"] == -1
+    assert all(table.empty for table in read.tables.values())
+
+
+def test_missing_run_attributes_are_named():
+    tables = plugin.event_tables(history(N, EVENTS), N)
+    with pytest.raises(FileFormatError, match="k_drive"):
+        plugin.event_attrs({"N": N, "plates": 3}, tables["increments"], source="run.h5")
+
+
+def test_grouping_by_regime_and_n(tmp_path):
+    write(tmp_path / "c.h5")
+    write(tmp_path / "s.h5", attrs={**RUN_ATTRS, "k_drive": 1e-3, "seed": 1})
+    write(tmp_path / "s2.h5", attrs={**RUN_ATTRS, "k_drive": 1e-3, "seed": 0})
+    files = [results.read_analysis_file(tmp_path / f, ("slips",)) for f in ("s.h5", "c.h5", "s2.h5")]
+    groups = results.group_runs(files)
+    assert list(groups) == [("compliant", 2), ("stiff", 2)]
+    assert [f.attrs["seed"] for f in groups[("stiff", 2)]] == [0, 1]
+    assert len(results.pooled(groups[("stiff", 2)], "slips")) == 14
+
+
+def test_plugin_is_registered():
+    found = registry.get("analysis", "numerical-events")
+    assert found.inputs == ("fem",)
+    assert found.version == plugin.VERSION
