@@ -1,0 +1,1 @@
+"""The experiments: time-series format, CSV import, virtual lever experiment and analysis."""

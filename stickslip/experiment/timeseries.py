@@ -1,0 +1,293 @@
+"""The experimental time-series format: one HDF5 file per run, for lab and virtual data.
+
+Layout (``shared/design.md``, section "Experimental time-series format"):
+
+===============  ==================  ==============================================
+item             shape / type        meaning
+===============  ==================  ==============================================
+``/t_F``         float64 [n_F]       force sample times [s], strictly increasing
+``/F``           float64 [n_F]       lever force [N]
+``/t_x``         float64 [n_frames]  camera frame times [s], strictly increasing
+``/x``           float64 [n_frames,  absolute horizontal slab positions [mm];
+                 n_slabs]            column i-1 is slab i (1 = lowest)
+attr ``n``       int                 driven slabs (springs attached), 1..n_slabs
+attr ``n_slabs`` int                 slabs in the stack
+attr ``protocol`` str                ``"stack"`` or ``"individual"``
+attr ``a``       int                 slab driven alone (individual), 0 for stack
+attr ``normal_force`` float          N [N]
+attr ``k_spring`` float              K [N/mm]
+attr ``h``       float               slab thickness [mm]
+attr ``H``       float               lever height [mm]
+attr ``V``       float               lever-top speed actually imposed [mm/s]
+===============  ==================  ==============================================
+
+Protocols (paper, section "Experiments" and appendix "Individual sliding"):
+
+- ``"stack"``: slabs 1..n carry a spring (n = 1..n_slabs), the slabs above ride
+  on slab n; ``a = 0``.
+- ``"individual"``: only slab ``a`` carries a spring, the slabs below it are
+  clamped; hence ``n = 1``. The lever is driven at ``V = V_paper / a`` so that
+  the spring of slab a moves at ``a h V / H = h V_paper / H``: ``V`` in the file
+  is the speed of the lever top during that run.
+
+Optional content: further attributes (a virtual run stores ``params`` as JSON
+and ``seed``) and tables written with :func:`stickslip.h5io.write_table`; a
+virtual run stores its ground truth as the tables ``truth`` (one row per slip)
+and ``interfaces`` (one row per interface), see :mod:`stickslip.solvers.lever`.
+"""
+
+import dataclasses
+
+import numpy as np
+
+from .. import h5io
+
+__all__ = ["PROTOCOLS", "ExperimentRecord", "write_timeseries", "read_timeseries", "read_truth",
+           "validate_record"]
+
+#: The known driving protocols.
+PROTOCOLS = ("stack", "individual")
+
+_DATASETS = ("t_F", "F", "t_x", "x")
+_INT_ATTRS = ("n", "n_slabs", "a")
+_FLOAT_ATTRS = ("normal_force", "k_spring", "h", "H", "V")
+
+
+@dataclasses.dataclass(frozen=True)
+class ExperimentRecord:
+    """One run of the lever experiment: force and slab-position time series.
+
+    Attributes
+    ----------
+    t_F : numpy.ndarray
+        float64 [n_F]: force sample times [s], strictly increasing.
+    F : numpy.ndarray
+        float64 [n_F]: lever force [N].
+    t_x : numpy.ndarray
+        float64 [n_frames]: camera frame times [s], strictly increasing.
+    x : numpy.ndarray
+        float64 [n_frames, n_slabs]: absolute horizontal slab positions [mm];
+        column i-1 is slab i (1 = lowest).
+    n : int
+        Number of driven slabs (springs attached), 1..n_slabs (1 for "individual").
+    n_slabs : int
+        Slabs in the stack (5 in the paper).
+    protocol : str
+        ``"stack"`` (slabs 1..n driven) or ``"individual"`` (only slab ``a``
+        driven, slabs below clamped).
+    a : int
+        Slab driven alone in the individual protocol; 0 for "stack".
+    normal_force : float
+        N [N].
+    k_spring : float
+        K [N/mm].
+    h : float
+        Slab thickness [mm].
+    H : float
+        Lever height [mm].
+    V : float
+        Lever-top speed imposed during the run [mm/s] (``V_paper / a`` for
+        the individual protocol).
+    """
+
+    t_F: np.ndarray
+    F: np.ndarray
+    t_x: np.ndarray
+    x: np.ndarray
+    n: int
+    n_slabs: int
+    protocol: str
+    a: int
+    normal_force: float
+    k_spring: float
+    h: float
+    H: float
+    V: float
+
+    @property
+    def R(self):
+        """Relative positions R_i = x_i - x_{i-1} (x_0 = 0, the fixed base) [mm].
+
+        Returns
+        -------
+        numpy.ndarray
+            float64 [n_frames, n_slabs]; column i-1 is interface i (under slab i).
+        """
+        return np.diff(self.x, axis=1, prepend=0.0)
+
+
+def _fail(source, item, expected):
+    raise h5io.FileFormatError(f"{source}: '{item}' {expected}")
+
+
+def _check_times(source, name, times):
+    if times.ndim != 1 or times.size < 2:
+        _fail(source, name, f"must be a 1-D array of at least 2 times, got shape {times.shape}")
+    if not np.all(np.isfinite(times)):
+        _fail(source, name, "must be finite (found NaN or inf)")
+    steps = np.diff(times)
+    if np.any(steps <= 0):
+        index = int(np.argmax(steps <= 0))
+        _fail(source, name, f"must be strictly increasing; sample {index + 1} ({times[index + 1]!r} s) "
+                            f"does not follow sample {index} ({times[index]!r} s)")
+
+
+def validate_record(record, source="record"):
+    """Check that a record is consistent; raise naming the first offending item.
+
+    Parameters
+    ----------
+    record : ExperimentRecord
+    source : str, optional
+        Name of the file or object, used in the message.
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If a time axis is not strictly increasing or not finite, a signal is not
+        finite or has a shape inconsistent with its time axis and ``n_slabs``, the
+        protocol is unknown, or ``n``, ``a`` or a physical constant is out of range.
+    """
+    if record.protocol not in PROTOCOLS:
+        _fail(source, "protocol", f"must be one of {', '.join(PROTOCOLS)}, got {record.protocol!r}")
+    if record.n_slabs < 1:
+        _fail(source, "n_slabs", f"must be >= 1, got {record.n_slabs}")
+    if not 1 <= record.n <= record.n_slabs:
+        _fail(source, "n", f"must be in 1..n_slabs={record.n_slabs}, got {record.n}")
+    if record.protocol == "stack" and record.a != 0:
+        _fail(source, "a", f"must be 0 for the stack protocol, got {record.a}")
+    if record.protocol == "individual":
+        if not 1 <= record.a <= record.n_slabs:
+            _fail(source, "a", f"must be in 1..n_slabs={record.n_slabs} for the individual protocol, "
+                               f"got {record.a}")
+        if record.n != 1:
+            _fail(source, "n", f"must be 1 for the individual protocol (one spring), got {record.n}")
+    for name in _FLOAT_ATTRS:
+        value = getattr(record, name)
+        if not (np.isfinite(value) and value > 0):
+            _fail(source, name, f"must be a finite number > 0, got {value!r}")
+    _check_times(source, "t_F", record.t_F)
+    _check_times(source, "t_x", record.t_x)
+    if record.F.shape != record.t_F.shape:
+        _fail(source, "F", f"must have the shape of t_F {record.t_F.shape}, got {record.F.shape}")
+    if record.x.shape != (record.t_x.size, record.n_slabs):
+        _fail(source, "x", f"must have shape (n_frames, n_slabs) = {(record.t_x.size, record.n_slabs)}, "
+                           f"got {record.x.shape}")
+    for name in ("F", "x"):
+        if not np.all(np.isfinite(getattr(record, name))):
+            _fail(source, name, "must be finite (found NaN or inf)")
+
+
+def write_timeseries(path, record, *, attrs=None, tables=None):
+    """Write a record to an HDF5 file (atomically; equal inputs give equal bytes).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Output file; replaced only once the new file is complete.
+    record : ExperimentRecord
+        Validated with :func:`validate_record` before anything is written.
+    attrs : Mapping[str, object], optional
+        Extra root attributes (e.g. ``params`` as a dict, stored as JSON, and ``seed``);
+        they must not reuse the names of the format's attributes.
+    tables : Mapping[str, pandas.DataFrame], optional
+        Extra tables by name (e.g. ``"truth"``), see :func:`stickslip.h5io.write_table`.
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the record is inconsistent.
+    ValueError
+        If an extra attribute or table would overwrite an item of the format.
+    """
+    validate_record(record, source=str(path))
+    reserved = set(_DATASETS) | set(_INT_ATTRS) | set(_FLOAT_ATTRS) | {"protocol"}
+    clashes = sorted(reserved & (set(attrs or {}) | set(tables or {})))
+    if clashes:
+        raise ValueError(f"extra attributes/tables must not reuse the format's names: {', '.join(clashes)}")
+    with h5io.atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
+        for name in _DATASETS:
+            h5io.write_dataset(f, name, np.asarray(getattr(record, name), dtype=np.float64))
+        for name in _INT_ATTRS:
+            f.attrs[name] = int(getattr(record, name))
+        for name in _FLOAT_ATTRS:
+            f.attrs[name] = float(getattr(record, name))
+        f.attrs["protocol"] = record.protocol
+        h5io.write_attrs(f, attrs or {})
+        for name, table in (tables or {}).items():
+            h5io.write_table(f, name, table)
+
+
+def read_timeseries(path):
+    """Read and validate a time-series file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    ExperimentRecord
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the file is missing or unreadable, a required dataset or attribute is
+        absent or of the wrong kind, or the content fails :func:`validate_record`;
+        the message names the file and the item.
+    """
+    source = str(path)
+    values = {}
+    with h5io.open_file(path) as f:
+        for name in _DATASETS:
+            if name not in f:
+                _fail(source, name, "is missing (required dataset)")
+            data = f[name][...]
+            if data.dtype.kind not in "fiu":
+                _fail(source, name, f"must be numeric, got dtype {data.dtype}")
+            values[name] = np.asarray(data, dtype=np.float64)
+        for name in _INT_ATTRS + _FLOAT_ATTRS + ("protocol",):
+            if name not in f.attrs:
+                _fail(source, name, "is missing (required attribute)")
+        for name in _INT_ATTRS:
+            value = f.attrs[name]
+            if not (np.issubdtype(type(value), np.integer) or (isinstance(value, float) and value.is_integer())):
+                _fail(source, name, f"must be an integer, got {value!r}")
+            values[name] = int(value)
+        for name in _FLOAT_ATTRS:
+            value = f.attrs[name]
+            if not np.issubdtype(type(value), np.number) or np.ndim(value) != 0:
+                _fail(source, name, f"must be a number, got {value!r}")
+            values[name] = float(value)
+        protocol = f.attrs["protocol"]
+        values["protocol"] = protocol.decode() if isinstance(protocol, bytes) else str(protocol)
+    record = ExperimentRecord(**values)
+    validate_record(record, source=source)
+    return record
+
+
+def read_truth(path, table="truth"):
+    """Read a ground-truth table of a virtual run.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    table : {"truth", "interfaces"}, optional
+        ``"truth"``: one row per slip the virtual experiment made; ``"interfaces"``:
+        one row per interface (its friction parameters and slip/creep totals).
+        Columns are documented in :mod:`stickslip.solvers.lever`.
+
+    Returns
+    -------
+    pandas.DataFrame or None
+        None if the file has no such table (lab data).
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the file is missing or unreadable.
+    """
+    with h5io.open_file(path) as f:
+        if table not in f:
+            return None
+        return h5io.read_table(f, table)

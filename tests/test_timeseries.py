@@ -1,0 +1,117 @@
+"""Experimental time-series format: round trip, ground-truth tables, every validation error."""
+
+import dataclasses
+import hashlib
+import re
+
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+
+from stickslip.experiment.timeseries import ExperimentRecord, read_timeseries, read_truth, write_timeseries
+from stickslip.h5io import FileFormatError
+
+
+def make_record(**changes):
+    t_F = np.arange(11) * 0.02
+    t_x = np.arange(3) * 0.2
+    x = np.array([[0.0, 1.0, 3.0], [0.5, 1.5, 3.5], [0.5, 2.0, 4.0]])
+    values = dict(t_F=t_F, F=np.linspace(1.0, 2.0, 11), t_x=t_x, x=x, n=2, n_slabs=3, protocol="stack",
+                  a=0, normal_force=49.0, k_spring=55.0, h=10.0, H=100.0, V=0.01)
+    values.update(changes)
+    return ExperimentRecord(**values)
+
+
+def test_relative_positions():
+    record = make_record()
+    np.testing.assert_array_equal(record.R, [[0.0, 1.0, 2.0], [0.5, 1.0, 2.0], [0.5, 1.5, 2.0]])
+
+
+def test_round_trip_with_truth_and_attrs(tmp_path):
+    record = make_record()
+    truth = pd.DataFrame({"t_start": [0.1], "a": [1], "dR": [0.02], "multi": [False]})
+    write_timeseries(tmp_path / "run.h5", record, attrs={"seed": 3, "params": {"n": 2}}, tables={"truth": truth})
+    back = read_timeseries(tmp_path / "run.h5")
+    for field in dataclasses.fields(ExperimentRecord):
+        np.testing.assert_array_equal(getattr(back, field.name), getattr(record, field.name))
+    pd.testing.assert_frame_equal(read_truth(tmp_path / "run.h5"), truth, check_dtype=False)
+    with h5py.File(tmp_path / "run.h5") as f:
+        assert f.attrs["seed"] == 3 and f.attrs["params"] == '{"n": 2}'
+
+
+def test_lab_file_has_no_truth_and_bytes_are_reproducible(tmp_path):
+    for name in ("1.h5", "2.h5"):
+        write_timeseries(tmp_path / name, make_record())
+    assert read_truth(tmp_path / "1.h5") is None
+    digests = {hashlib.sha256((tmp_path / name).read_bytes()).hexdigest() for name in ("1.h5", "2.h5")}
+    assert len(digests) == 1
+
+
+def test_individual_protocol_accepted(tmp_path):
+    write_timeseries(tmp_path / "i.h5", make_record(protocol="individual", a=3, n=1))
+    assert read_timeseries(tmp_path / "i.h5").a == 3
+
+
+BAD_RECORDS = [
+    (dict(protocol="sideways"), "'protocol' must be one of"),
+    (dict(n=4), "'n' must be in 1..n_slabs=3"),
+    (dict(n=0), "'n' must be in 1..n_slabs=3"),
+    (dict(a=1), "'a' must be 0 for the stack protocol"),
+    (dict(protocol="individual", a=4, n=1), "'a' must be in 1..n_slabs=3"),
+    (dict(protocol="individual", a=2, n=2), "'n' must be 1 for the individual protocol"),
+    (dict(k_spring=-1.0), "'k_spring' must be a finite number > 0"),
+    (dict(V=float("nan")), "'V' must be a finite number > 0"),
+    (dict(t_F=np.r_[0.0, 0.02, 0.01, np.arange(3, 11) * 0.02]), "'t_F' must be strictly increasing"),
+    (dict(t_x=np.array([0.0, 0.2, 0.2])), "'t_x' must be strictly increasing"),
+    (dict(t_x=np.array([0.0, np.nan, 0.4])), "'t_x' must be finite"),
+    (dict(F=np.r_[np.ones(10), np.nan]), "'F' must be finite"),
+    (dict(F=np.ones(10)), "'F' must have the shape of t_F"),
+    (dict(x=np.zeros((3, 2))), "'x' must have shape (n_frames, n_slabs) = (3, 3)"),
+    (dict(x=np.full((3, 3), np.inf)), "'x' must be finite"),
+]
+
+
+@pytest.mark.parametrize("changes, message", BAD_RECORDS)
+def test_writer_rejects_inconsistent_records(tmp_path, changes, message):
+    with pytest.raises(FileFormatError, match=re.escape(message)):
+        write_timeseries(tmp_path / "bad.h5", make_record(**changes))
+    assert not (tmp_path / "bad.h5").exists()
+
+
+def _corrupt(path, edit):
+    write_timeseries(path, make_record())
+    with h5py.File(path, "r+") as f:
+        edit(f)
+
+
+CORRUPTIONS = [
+    (lambda f: f.__delitem__("x"), "'x' is missing (required dataset)"),
+    (lambda f: f.attrs.__delitem__("k_spring"), "'k_spring' is missing (required attribute)"),
+    (lambda f: f.attrs.__setitem__("n", 1.5), "'n' must be an integer"),
+    (lambda f: f.attrs.__setitem__("h", "ten"), "'h' must be a number"),
+    (lambda f: f.attrs.__setitem__("protocol", "free"), "'protocol' must be one of"),
+    (lambda f: f["t_F"].__setitem__(3, 0.0), "'t_F' must be strictly increasing; sample 3"),
+    (lambda f: f["x"].__setitem__((1, 1), np.nan), "'x' must be finite"),
+]
+
+
+@pytest.mark.parametrize("edit, message", CORRUPTIONS)
+def test_reader_names_the_bad_item(tmp_path, edit, message):
+    _corrupt(tmp_path / "run.h5", edit)
+    with pytest.raises(FileFormatError, match=re.escape(message)) as error:
+        read_timeseries(tmp_path / "run.h5")
+    assert str(tmp_path / "run.h5") in str(error.value)
+
+
+def test_reader_rejects_missing_and_non_hdf5_files(tmp_path):
+    with pytest.raises(FileFormatError, match="no such file"):
+        read_timeseries(tmp_path / "absent.h5")
+    (tmp_path / "text.h5").write_text("not hdf5")
+    with pytest.raises(FileFormatError, match="not a readable HDF5 file"):
+        read_timeseries(tmp_path / "text.h5")
+
+
+def test_extra_items_cannot_overwrite_the_format(tmp_path):
+    with pytest.raises(ValueError, match="must not reuse the format's names: n"):
+        write_timeseries(tmp_path / "run.h5", make_record(), attrs={"n": 5})
