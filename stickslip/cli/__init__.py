@@ -17,7 +17,7 @@ from ..registry import PluginError
 __all__ = ["main", "COMMANDS"]
 
 #: Sub-command modules, in the order of ``stickslip --help``.
-COMMANDS = ("simulate", "plugins")
+COMMANDS = ("mesh", "simulate", "plugins")
 
 USER_ERRORS = (ParameterError, PluginError, FileFormatError)
 
