@@ -1,0 +1,164 @@
+"""The ``experiment-events`` analysis: every slip of one experimental recording, with its
+interface, force drop, friction drop, waiting time, aging rate and slow slip.
+
+Input: one time-series file (:mod:`stickslip.experiment.timeseries`; lab recording or ``lever``
+run). Output: one HDF5 file with two tables (:func:`stickslip.h5io.write_table`) and the run's
+attributes copied to the root:
+
+``slips``: one row per slip of one interface, sorted by time (see :func:`analyse_record`).
+``interfaces``: one row per interface ``a``: ``R_tot`` [mm] (total sliding over the analysed
+record), ``dR_sum`` [mm] (sum of its detected slips), ``R_slow`` (``1 - dR_sum / R_tot``),
+``n_slips``, ``n_multi``.
+
+The first ``t_exclude`` seconds of the record (the paper's 300 s transient) are excluded from
+both tables; slips there still count as the previous slip of an interface for ``T`` and the
+drift.
+"""
+
+import dataclasses
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import h5io, registry
+from ..params import ParameterError, param, params_to_dict
+from . import aging, detection, kinematics
+from .timeseries import read_timeseries
+
+__all__ = ["ExperimentEventsParams", "analyse_record", "run", "VERSION"]
+
+VERSION = "1"
+
+SLIP_COLUMNS = ["event", "t", "a", "n", "protocol", "multi", "t_start", "t_end", "dF", "dmu", "T", "dR",
+                "dR_from_dF", "B_a", "drift", "slow_slip_before"]
+
+
+@dataclasses.dataclass(frozen=True)
+class ExperimentEventsParams:
+    """Parameters of the slip detection and of the per-slip quantities."""
+
+    threshold: float = param(detection.VELOCITY_THRESHOLD, "smoothed interface velocity above which a frame "
+                             "belongs to a slip", unit="mm/s", exclusive_minimum=0)
+    average_frames: int = param(detection.AVERAGE_FRAMES, "running-average width of the velocity (odd)",
+                                unit="frames", minimum=1)
+    min_frames: int = param(detection.MIN_FRAMES, "minimum number of consecutive fast frames of a slip",
+                            unit="frames", minimum=1)
+    force_window: float = param(2.0, "length of the force fits before and after a slip", unit="s",
+                                exclusive_minimum=0)
+    t_exclude: float = param(300.0, "initial transient excluded from the tables (from the first frame)",
+                             unit="s", minimum=0)
+    t0: float = param(aging.T0, "time scale T0 of the aging law dmu = B ln(T/T0)", unit="s", exclusive_minimum=0)
+    slow_slip_drift: float = param(aging.SLOW_SLIP_DRIFT, "drift of an interface between two of its slips "
+                                   "above which slow slip occurred", unit="mm", minimum=0)
+
+    def check(self):
+        """Raise ParameterError if the running-average width is even."""
+        if self.average_frames % 2 == 0:
+            raise ParameterError(f"parameter 'average_frames': expected an odd number, got {self.average_frames}")
+
+
+def _event_windows(slips):
+    """Bracket of each event and the bracket ends of its neighbours (force fits stop there)."""
+    events = slips.groupby("event").agg(t_start=("t_start", "min"), t_end=("t_end", "max"))
+    previous = np.concatenate([[-np.inf], events["t_end"].to_numpy()[:-1]])
+    following = np.concatenate([events["t_start"].to_numpy()[1:], [np.inf]])
+    return events["t_start"].to_numpy(), events["t_end"].to_numpy(), previous, following
+
+
+def analyse_record(record, params=ExperimentEventsParams()):
+    """Detect the slips of one recording and measure them.
+
+    Parameters
+    ----------
+    record : stickslip.experiment.timeseries.ExperimentRecord
+        Force ``F(t_F)`` [N], slab positions ``x(t_x)`` [mm] and the apparatus attributes.
+    params : ExperimentEventsParams
+
+    Returns
+    -------
+    slips : pandas.DataFrame
+        One row per slip of one interface, columns :data:`SLIP_COLUMNS`:
+        ``event`` (slips with overlapping brackets share it), ``t`` [s] (time of the slip),
+        ``a`` (interface, 1 = lowest), ``n``, ``protocol``, ``multi`` (bool: more than one interface
+        slipped in the event; ``dmu``, ``dR_from_dF``, ``B_a`` are then NaN since the lever
+        kinematics of a single slip does not apply), ``t_start``, ``t_end`` [s] (frames that
+        bracket the slip), ``dF`` [N] (force drop of the event), ``dmu`` [-]
+        (:func:`~stickslip.experiment.kinematics.dmu_from_dF`), ``T`` [s] (since the previous slip
+        of interface ``a``; NaN for its first), ``dR`` [mm] (measured), ``dR_from_dF`` [mm]
+        (:func:`~stickslip.experiment.kinematics.dR_from_dF`), ``B_a``
+        (``dmu / ln(T / T0)``), ``drift`` [mm] (``R_a`` at ``t_start`` minus ``R_a`` at the end of
+        the previous slip of ``a``), ``slow_slip_before`` (``drift >= slow_slip_drift``).
+    interfaces : pandas.DataFrame
+        Columns ``a``, ``R_tot``, ``dR_sum`` [mm], ``R_slow`` [-], ``n_slips``, ``n_multi``.
+    """
+    R = record.R
+    slips = detection.detect_slips(record.t_x, R, threshold=params.threshold, width=params.average_frames,
+                                   min_frames=params.min_frames)
+    t_start, t_end, previous, following = _event_windows(slips)
+    event_dF = detection.force_drop(record.t_F, record.F, t_start, t_end, window=params.force_window,
+                                    t_previous=previous, t_next=following)
+    slips["dF"] = event_dF[slips["event"].to_numpy()]
+    single = ~slips["multi"].to_numpy()
+    geometry = dict(h=record.h, H=record.H)
+    a = slips["a"].to_numpy()
+    slips["dmu"] = np.where(single, kinematics.dmu_from_dF(slips["dF"], a, record.n, record.protocol,
+                                                           normal_force=record.normal_force, **geometry), np.nan)
+    slips["dR_from_dF"] = np.where(single, kinematics.dR_from_dF(slips["dF"], a, record.n, record.protocol,
+                                                                 k_spring=record.k_spring, **geometry), np.nan)
+    # Per interface, in time order: waiting time and drift since the previous slip.
+    slips = slips.sort_values(["a", "t"], kind="stable")
+    by_interface = slips.groupby("a")
+    slips["T"] = slips["t"] - by_interface["t"].shift()
+    column = slips["a"].to_numpy() - 1
+    end_of_previous = by_interface["i_end"].shift()
+    has_previous = end_of_previous.notna().to_numpy()
+    previous_index = end_of_previous.fillna(0).to_numpy(dtype=int)
+    drift = R[slips["i_start"].to_numpy(), column] - R[previous_index, column]
+    slips["drift"] = np.where(has_previous, drift, np.nan)
+    slips["slow_slip_before"] = slips["drift"].to_numpy() >= params.slow_slip_drift
+    slips["B_a"] = aging.aging_rate(slips["dmu"], slips["T"], t0=params.t0)
+    slips["n"] = int(record.n)
+    slips["protocol"] = str(record.protocol)
+
+    first_frame = int(np.searchsorted(record.t_x, record.t_x[0] + params.t_exclude, side="left"))
+    first_frame = min(first_frame, len(record.t_x) - 1)
+    slips = slips[slips["i_start"].to_numpy() >= first_frame].sort_values(["t", "a"], kind="stable")
+    slips = slips[SLIP_COLUMNS].reset_index(drop=True)
+
+    interfaces = pd.DataFrame({"a": np.arange(1, R.shape[1] + 1)})
+    interfaces["R_tot"] = R[-1] - R[first_frame]
+    grouped = slips.groupby("a")
+    interfaces["dR_sum"] = interfaces["a"].map(grouped["dR"].sum()).fillna(0.0)
+    interfaces["R_slow"] = aging.slow_slip_fraction(interfaces["R_tot"], interfaces["dR_sum"])
+    interfaces["n_slips"] = interfaces["a"].map(grouped.size()).fillna(0).astype(int)
+    interfaces["n_multi"] = interfaces["a"].map(grouped["multi"].sum()).fillna(0).astype(int)
+    return slips, interfaces
+
+
+def _sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for chunk in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+@registry.register("analysis", "experiment-events", VERSION, ExperimentEventsParams, inputs=("lever",))
+def run(params, input, output):
+    """Detect and measure every slip of one experimental time series (lab or lever run)."""
+    input = Path(input)
+    record = read_timeseries(input)
+    slips, interfaces = analyse_record(record, params)
+    with h5io.open_file(input) as source:
+        run_attrs = dict(source.attrs)
+    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as f:
+        for key, value in run_attrs.items():
+            f.attrs[key] = value
+        h5io.write_attrs(f, {"analysis": "experiment-events", "analysis_version": VERSION,
+                             "analysis_params": json.dumps(params_to_dict(params), sort_keys=True),
+                             "input_sha256": _sha256(input)})
+        h5io.write_table(f, "slips", slips)
+        h5io.write_table(f, "interfaces", interfaces)
