@@ -1,0 +1,270 @@
+"""Time-resolved multi-slip events: rupture-front velocity and the delay between interfaces.
+
+A stored kick increment of a ``fem`` run is re-run while every block failure is recorded
+(interface ``a``, ``block``, time ``t`` since the kick, ``direction``), as the paper does
+for its event maps (appendix "Front dynamics -- numerics"). From the failures of one event:
+
+- the *slipping* interfaces are those on which every block fails at least once (the
+  paper's definition), ordered by their first failure;
+- the front velocity ``c_f`` of the first slipping interface: the first failure time of
+  each block against its periodic distance from the nucleation block (the first block to
+  fail) is a straight line in the ballistic part of the rupture; ``c_f`` is the inverse slope
+  of a least-squares fit over distances ``fit_from ... fit_to`` times half the interface
+  length, in units of the shear-wave speed c_s;
+- the delay ``tau`` between the first failure on the first and on the second slipping
+  interface, in units of H/c_s with H the distance between the mid-lines of two adjacent
+  interfaces (one plate plus one block layer).
+
+The ``front-dynamics`` analysis plugin applies this to the first ``max_events``
+steady-state multi-slip increments of a run.
+"""
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+
+from .. import h5io
+from ..h5io import FileFormatError
+from ..params import ParameterError, param
+from ..registry import register
+from . import extraction
+from .plugin import event_attrs
+
+__all__ = ["FrontParams", "VERSION", "slipping_interfaces", "front_fit", "analyse_event", "multi_slip_increments",
+           "interface_spacing", "front_tables", "run"]
+
+VERSION = "1"
+
+FAILURE_COLUMNS = ("a", "block", "t", "direction")
+
+#: Columns of the output table "failures" (one row per block failure) and their types.
+FAILURE_DTYPES = {"increment": "int64", "a": "int64", "block": "int64", "t": "float64", "direction": "int64"}
+
+#: Columns of the output table "fronts" (one row per re-run event), see :func:`analyse_event`.
+FRONT_DTYPES = {"increment": "int64", "s": "int64", "a_first": "int64", "a_second": "int64", "nucleation": "int64",
+                "c_f": "float64", "fit_t0": "float64", "fit_points": "int64", "t_first": "float64", "tau": "float64"}
+
+
+def _check_failures(failures, source):
+    missing = [c for c in FAILURE_COLUMNS if c not in failures.columns]
+    if missing:
+        raise FileFormatError(f"{source}: failure table lacks column(s) {', '.join(missing)}")
+
+
+def _first_failures(failures, a):
+    """First failure time of every block of interface ``a`` (Series indexed by block, sorted)."""
+    sub = failures[failures["a"].to_numpy() == a]
+    return sub.groupby("block", sort=True)["t"].min()
+
+
+def slipping_interfaces(failures, N):
+    """Interfaces on which every block failed at least once, ordered by their first failure.
+
+    Parameters
+    ----------
+    failures : pandas.DataFrame
+        Columns ``a``, ``block`` (0 ... N-1), ``t`` [FE time], ``direction``.
+    N : int
+        Blocks per interface.
+
+    Returns
+    -------
+    list[tuple[int, float]]
+        (interface, time of its first failure), earliest first (ties: lower interface first).
+    """
+    found = []
+    for a, sub in failures.groupby("a", sort=True):
+        if sub["block"].nunique() == N:
+            found.append((int(a), float(sub["t"].min())))
+    return sorted(found, key=lambda item: (item[1], item[0]))
+
+
+def front_fit(failures, a, N, *, fit_from=0.3, fit_to=0.9):
+    """Fit the ballistic rupture front on interface ``a``.
+
+    Parameters
+    ----------
+    failures : pandas.DataFrame
+        Columns ``a``, ``block``, ``t`` [FE time].
+    a : int
+        Interface.
+    N : int
+        Blocks per interface (periodic: the largest distance is N/2 blocks).
+    fit_from, fit_to : float
+        Fitted distances from the nucleation block, as fractions of N/2.
+
+    Returns
+    -------
+    dict[str, float]
+        ``nucleation`` (block of the first failure; lowest index on ties), ``speed``
+        (front speed [blocks per FE time unit]; NaN with fewer than 3 fitted blocks),
+        ``t0`` (time at which the fitted front leaves the nucleation block [FE time]) and
+        ``points`` (number of fitted blocks).
+    """
+    first = _first_failures(failures, a)
+    blocks = first.index.to_numpy(dtype=np.int64)
+    times = first.to_numpy(dtype=float)
+    nucleation = int(blocks[np.argmin(times)])
+    offset = np.abs(blocks - nucleation)
+    distance = np.minimum(offset, N - offset).astype(float)
+    fitted = (distance >= fit_from * N / 2) & (distance <= fit_to * N / 2)
+    result = {"nucleation": nucleation, "speed": np.nan, "t0": np.nan, "points": int(fitted.sum())}
+    if fitted.sum() >= 3 and np.ptp(distance[fitted]) > 0:
+        slope, intercept = np.polyfit(distance[fitted], times[fitted], 1)
+        if slope > 0:
+            result.update(speed=1.0 / slope, t0=intercept)
+    return result
+
+
+def analyse_event(failures, N, *, h, c_s, spacing, fit_from=0.3, fit_to=0.9):
+    """Front velocity and inter-interface delay of one re-run event.
+
+    Parameters
+    ----------
+    failures : pandas.DataFrame
+        Columns ``a``, ``block``, ``t`` [FE time], ``direction``.
+    N : int
+        Blocks per interface.
+    h : float
+        Block size l0 [FE length].
+    c_s : float
+        Shear-wave speed [FE length / FE time].
+    spacing : float
+        Distance H between the mid-lines of adjacent interfaces [FE length].
+    fit_from, fit_to : float
+        See :func:`front_fit`.
+
+    Returns
+    -------
+    dict[str, float]
+        ``s`` (number of slipping interfaces), ``a_first``, ``a_second`` (0 if fewer than
+        two slip), ``nucleation`` (block), ``c_f`` (front speed of the first slipping
+        interface [c_s]), ``fit_t0`` [FE time], ``fit_points``, ``t_first`` (first failure
+        [FE time]) and ``tau`` (delay between the first failures of the first two slipping
+        interfaces [H/c_s]; NaN if fewer than two slip).
+    """
+    _check_failures(failures, "failure table")
+    order = slipping_interfaces(failures, N)
+    row = {"s": len(order), "a_first": 0, "a_second": 0, "nucleation": -1, "c_f": np.nan, "fit_t0": np.nan,
+           "fit_points": 0, "t_first": float(failures["t"].min()) if len(failures) else np.nan, "tau": np.nan}
+    if not order:
+        return row
+    fit = front_fit(failures, order[0][0], N, fit_from=fit_from, fit_to=fit_to)
+    row.update(a_first=order[0][0], nucleation=fit["nucleation"], c_f=fit["speed"] * h / c_s, fit_t0=fit["t0"],
+               fit_points=fit["points"])
+    if len(order) > 1:
+        row.update(a_second=order[1][0], tau=(order[1][1] - order[0][1]) * c_s / spacing)
+    return row
+
+
+def multi_slip_increments(classified, max_events):
+    """The first ``max_events`` steady-state multi-slip increments of a classified run.
+
+    Parameters
+    ----------
+    classified : pandas.DataFrame
+        Output of :func:`stickslip.events.extraction.classify_increments`.
+    max_events : int
+
+    Returns
+    -------
+    numpy.ndarray
+        Increment numbers, ascending.
+    """
+    chosen = classified["steady"].to_numpy(dtype=bool) & (classified["kind"].to_numpy() == "multi")
+    return classified["increment"].to_numpy()[chosen][:max_events]
+
+
+def interface_spacing(attrs, *, source="run"):
+    """Distance H between the mid-lines of adjacent interfaces, from the run's layer heights.
+
+    Parameters
+    ----------
+    attrs : Mapping[str, object]
+        Run attributes with ``layer_heights``: mid-height of every layer l = 0 ... 2n
+        (l = 2i plate i, l = 2a - 1 interface a) [FE length].
+    source : str, optional
+        Origin of the attributes, for error messages.
+
+    Returns
+    -------
+    float
+        ``layer_heights[3] - layer_heights[1]`` [FE length]; NaN with a single interface.
+    """
+    if "layer_heights" not in attrs:
+        raise FileFormatError(f"{source}: run attributes lack 'layer_heights' (mid-height of every layer)")
+    heights = np.asarray(attrs["layer_heights"], dtype=float)
+    return float(heights[3] - heights[1]) if heights.size >= 4 else np.nan
+
+
+@dataclasses.dataclass(frozen=True)
+class FrontParams:
+    """Parameters of the front-dynamics analysis."""
+
+    max_events: int = param(10, "steady-state multi-slip increments re-run per fem run (the first ones)", minimum=1)
+    fit_from: float = param(0.3, "front fit: smallest distance from the nucleation block, fraction of half the "
+                                 "interface length", minimum=0.0, maximum=1.0)
+    fit_to: float = param(0.9, "front fit: largest distance from the nucleation block, fraction of half the "
+                               "interface length", minimum=0.0, maximum=1.0)
+
+    def check(self):
+        """The fit window must not be empty."""
+        if self.fit_from >= self.fit_to:
+            raise ParameterError(f"parameters 'fit_from' ({self.fit_from}) and 'fit_to' ({self.fit_to}): "
+                                 "expected fit_from < fit_to")
+
+
+def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
+    """Re-run the chosen multi-slip events and analyse each.
+
+    Parameters
+    ----------
+    classified : pandas.DataFrame
+        Output of :func:`stickslip.events.extraction.classify_increments`.
+    rerun : Callable[[int], pandas.DataFrame]
+        Returns the failures (``a``, ``block``, ``t`` [FE time], ``direction``) of one increment.
+    N, h, c_s, spacing
+        See :func:`analyse_event`.
+    params : FrontParams
+
+    Returns
+    -------
+    tuple[pandas.DataFrame, pandas.DataFrame]
+        ``failures`` (columns of :data:`FAILURE_DTYPES`, ordered by increment, time,
+        interface, block) and ``fronts`` (columns of :data:`FRONT_DTYPES`, one row per event).
+    """
+    failures, fronts = [], []
+    for increment in multi_slip_increments(classified, params.max_events):
+        events = rerun(int(increment))
+        _check_failures(events, f"re-run of increment {increment}")
+        events = events[list(FAILURE_COLUMNS)].sort_values(["t", "a", "block"], kind="stable")
+        failures.append(events.assign(increment=int(increment)))
+        row = analyse_event(events, N, h=h, c_s=c_s, spacing=spacing, fit_from=params.fit_from, fit_to=params.fit_to)
+        fronts.append({"increment": int(increment), **row})
+    failure_table = pd.concat(failures, ignore_index=True) if failures else pd.DataFrame(columns=list(FAILURE_DTYPES))
+    front_table = pd.DataFrame(fronts, columns=list(FRONT_DTYPES))
+    return failure_table[list(FAILURE_DTYPES)].astype(FAILURE_DTYPES), front_table.astype(FRONT_DTYPES)
+
+
+@register("analysis", "front-dynamics", VERSION, FrontParams, inputs=("fem",))
+def run(params, input, output):
+    """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
+    from ..fem.output import read_increments, read_run_attrs, rerun_with_failures  # loads numba kernels
+
+    run_attrs = read_run_attrs(input)
+    for key in ("N", "h", "c_s"):
+        if key not in run_attrs:
+            raise FileFormatError(f"{input}: run attributes lack {key}")
+    N = int(run_attrs["N"])
+    spacing = interface_spacing(run_attrs, source=str(input))
+    classified = extraction.classify_increments(read_increments(input), N, source=str(input))
+    failures, fronts = front_tables(classified, lambda increment: rerun_with_failures(input, increment), N=N,
+                                    h=float(run_attrs["h"]), c_s=float(run_attrs["c_s"]), spacing=spacing,
+                                    params=params)
+    attrs = {**event_attrs(run_attrs, classified, source=str(input)), "interface_spacing": spacing,
+             "analysis": "front-dynamics", "analysis_version": VERSION}
+    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
+        h5io.write_attrs(file, attrs)
+        h5io.write_table(file, "failures", failures)
+        h5io.write_table(file, "fronts", fronts)
