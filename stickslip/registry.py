@@ -54,7 +54,8 @@ KINDS = ("solver", "analysis", "figure")
 ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.analyses", "figure": "stickslip.figures"}
 
 #: Modules whose import registers the built-in plugins.
-BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis")
+BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis",
+                   "stickslip.figures.mesh")
 
 _RUN_SIGNATURES = {
     "solver": (["params", "output"], ["threads", "inputs"]),
