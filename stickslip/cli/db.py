@@ -1,0 +1,144 @@
+"""``stickslip db``: query and (re)build the results database.
+
+Sub-commands: ``runs`` and ``events`` (filters, ``--format table|csv|json``),
+``sql "SELECT ..."`` (read-only connection), ``ingest RECORD...`` (add records),
+``rebuild`` (recreate the database from the records under the results directory).
+"""
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from ..h5io import FileFormatError
+
+FORMATS = ("table", "csv", "json")
+
+#: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
+RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "N", "regime",
+               "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
+
+EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",
+                 "interface", "slip", "time", "increment")
+
+
+def _common(parser, default_format="table"):
+    from ..provenance.query import DEFAULT_DATABASE
+
+    parser.add_argument("--db", type=Path, default=Path(DEFAULT_DATABASE),
+                        help=f"database file (default {DEFAULT_DATABASE})")
+    parser.add_argument("--format", choices=FORMATS, default=default_format, help="output format (default table)")
+    parser.add_argument("--all-columns", action="store_true", help="every column (table format shows the main ones)")
+
+
+def add_parser(subparsers):
+    """Add the ``db`` sub-command and its own sub-commands."""
+    parser = subparsers.add_parser("db", help="query or rebuild the results database",
+                                   description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="db_command", required=True, metavar="DB_COMMAND")
+
+    runs = commands.add_parser("runs", help="list runs with their parameters")
+    _common(runs)
+    runs.add_argument("--kind", choices=("solver", "analysis", "figure", "mesh"))
+    runs.add_argument("--plugin")
+    runs.add_argument("--solver")
+    runs.add_argument("--n", type=int, help="number of driven interfaces")
+    runs.add_argument("--regime")
+    runs.add_argument("--seed", type=int)
+    runs.set_defaults(func=run_runs)
+
+    events = commands.add_parser("events", help="list slip events with their simulation's parameters")
+    _common(events)
+    events.add_argument("--solver")
+    events.add_argument("--analysis")
+    events.add_argument("--source", choices=("numerical", "experimental"))
+    events.add_argument("--n", type=int, help="number of driven interfaces")
+    events.add_argument("--interface", type=int, help="interface (slab) a, 1 = lowest")
+    events.add_argument("--regime")
+    events.add_argument("--seed", type=int)
+    events.add_argument("--run-id", help="one simulation")
+    events.set_defaults(func=run_events)
+
+    sql = commands.add_parser("sql", help="run SQL on a read-only connection")
+    _common(sql)
+    sql.add_argument("query", help='e.g. "SELECT n, COUNT(*) FROM simulations GROUP BY n"')
+    sql.set_defaults(func=run_sql)
+
+    ingest = commands.add_parser("ingest", help="add provenance records to the database (idempotent)")
+    ingest.add_argument("records", nargs="+", type=Path, help="*.provenance.json files")
+    ingest.add_argument("--db", type=Path, default=None, help="database file (default results/stickslip.sqlite)")
+    ingest.set_defaults(func=run_ingest)
+
+    rebuild = commands.add_parser("rebuild", help="recreate the database from every record under the results")
+    rebuild.add_argument("--results", type=Path, default=Path("results"), help="results directory (default results)")
+    rebuild.add_argument("--db", type=Path, default=None, help="database file (default RESULTS/stickslip.sqlite)")
+    rebuild.set_defaults(func=run_rebuild)
+
+
+def _print(frame, args, columns=None):
+    if args.format == "table" and columns is not None and not args.all_columns:
+        frame = frame[[c for c in columns if c in frame.columns]]
+    if args.format == "csv":
+        frame.to_csv(sys.stdout, index=False)
+    elif args.format == "json":
+        sys.stdout.write(frame.to_json(orient="records", indent=1) + "\n")
+    elif frame.empty:
+        print("(no rows)")
+    else:
+        with pd.option_context("display.max_rows", None, "display.max_columns", None, "display.width", 200):
+            print(frame.to_string(index=False))
+    return 0
+
+
+def run_runs(args):
+    """``db runs``."""
+    from ..provenance import query
+
+    frame = query.runs(args.db, kind=args.kind, plugin=args.plugin, solver=args.solver, n=args.n,
+                       regime=args.regime, seed=args.seed)
+    return _print(frame, args, RUN_COLUMNS)
+
+
+def run_events(args):
+    """``db events``."""
+    from ..provenance import query
+
+    frame = query.events(args.db, solver=args.solver, analysis=args.analysis, source=args.source, n=args.n,
+                         interface=args.interface, regime=args.regime, seed=args.seed, run_id=args.run_id)
+    return _print(frame, args, EVENT_COLUMNS)
+
+
+def run_sql(args):
+    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors."""
+    import sqlalchemy.exc
+
+    from ..provenance import query
+
+    try:
+        frame = query.sql(args.query, args.db)
+    except sqlalchemy.exc.OperationalError as error:
+        raise FileFormatError(f"{args.db}: {error.orig}") from None
+    return _print(frame, args)
+
+
+def run_ingest(args):
+    """``db ingest``."""
+    from ..provenance.ingest import ingest
+    from ..provenance.query import DEFAULT_DATABASE
+
+    counts = ingest(args.db or Path(DEFAULT_DATABASE), args.records)
+    print(", ".join(f"{count} {name}" for name, count in counts.items()) + " ingested")
+    return 0
+
+
+def run_rebuild(args):
+    """``db rebuild``."""
+    from ..provenance.ingest import find_records, ingest
+
+    records = find_records(args.results)
+    if not records:
+        raise FileFormatError(f"{args.results}: no provenance records (*.provenance.json) found")
+    database = args.db or args.results / "stickslip.sqlite"
+    counts = ingest(database, records, rebuild=True)
+    print(f"{database}: rebuilt from " + ", ".join(f"{count} {name}" for name, count in counts.items()))
+    return 0

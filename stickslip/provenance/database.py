@@ -1,0 +1,190 @@
+"""The results database: SQLAlchemy models of runs, files, simulations, slip events and figures.
+
+One SQLite file (``results/stickslip.sqlite``) written only by the workflow's
+``database`` rule or ``stickslip db ingest|rebuild`` (:mod:`.ingest`); read by
+:mod:`.query`, ``stickslip db`` and any SQLite client. docs/database.md
+documents every table and column.
+
+Tables
+------
+schema_info   key/value: ``schema_version`` (:data:`SCHEMA_VERSION`), ``package_version``.
+runs          one row per job (simulation, analysis, figure, mesh): its provenance record.
+artifacts     every input and output file of every run, with sha256 and size.
+simulations   one row per solver run: typed physics parameters.
+slip_events   one row per slip of one interface in one event (numerical and experimental).
+figures       one row per figure: its PDF and PNG.
+
+View ``slip_events_full``: slip_events joined with the parameters of their simulation.
+"""
+
+from sqlalchemy import Boolean, Float, ForeignKey, Index, Integer, String, Text, create_engine, event, text
+from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
+
+from ..h5io import FileFormatError
+
+__all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "Artifact", "Simulation", "SlipEvent", "Figure",
+           "VIEWS", "engine_for", "create_schema"]
+
+#: Version of the table layout; a database of another version must be rebuilt.
+SCHEMA_VERSION = 1
+
+
+class Base(DeclarativeBase):
+    """Declarative base of the results database."""
+
+
+class SchemaInfo(Base):
+    """Key/value facts about the database itself (``schema_version``, ``package_version``)."""
+
+    __tablename__ = "schema_info"
+    key: Mapped[str] = mapped_column(String, primary_key=True)
+    value: Mapped[str] = mapped_column(String)
+
+
+class Run(Base):
+    """One job of the workflow, from its provenance record."""
+
+    __tablename__ = "runs"
+    run_id: Mapped[str] = mapped_column(String(16), primary_key=True, doc="job id (16 hex)")
+    kind: Mapped[str] = mapped_column(String, index=True, doc="solver, analysis, figure or mesh")
+    plugin: Mapped[str] = mapped_column(String, index=True, doc="plugin name")
+    plugin_version: Mapped[str] = mapped_column(String)
+    code_hash: Mapped[str] = mapped_column(String, doc="hash of the plugin's package sources")
+    package_version: Mapped[str] = mapped_column(String)
+    git_commit: Mapped[str | None] = mapped_column(String)
+    git_dirty: Mapped[bool | None] = mapped_column(Boolean)
+    params: Mapped[str] = mapped_column(Text, doc="all parameters, JSON")
+    seed: Mapped[int | None] = mapped_column(Integer)
+    threads: Mapped[int] = mapped_column(Integer)
+    python_version: Mapped[str] = mapped_column(String)
+    numpy_version: Mapped[str | None] = mapped_column(String)
+    numba_version: Mapped[str | None] = mapped_column(String)
+    h5py_version: Mapped[str | None] = mapped_column(String)
+    versions: Mapped[str] = mapped_column(Text, doc="all library versions, JSON")
+    host: Mapped[str] = mapped_column(String)
+    started_at: Mapped[str] = mapped_column(String, doc="ISO 8601, UTC")
+    finished_at: Mapped[str] = mapped_column(String, doc="ISO 8601, UTC")
+    wall_time_s: Mapped[float] = mapped_column(Float, doc="[s]")
+    peak_memory_mib: Mapped[float] = mapped_column(Float, doc="peak resident memory of the job [MiB]")
+    record_path: Mapped[str] = mapped_column(String, doc="the provenance JSON file")
+
+
+class Artifact(Base):
+    """One input or output file of a run."""
+
+    __tablename__ = "artifacts"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
+    run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), index=True)
+    direction: Mapped[str] = mapped_column(String, doc="input or output")
+    role: Mapped[str] = mapped_column(String, doc="output, pdf, png, mesh, solver:<name>, analysis:<name>")
+    path: Mapped[str] = mapped_column(String, index=True)
+    sha256: Mapped[str] = mapped_column(String(64), index=True)
+    bytes: Mapped[int] = mapped_column(Integer)
+
+
+class Simulation(Base):
+    """One solver run with its key physics parameters as typed columns (NULL where not a parameter)."""
+
+    __tablename__ = "simulations"
+    run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), primary_key=True)
+    solver: Mapped[str] = mapped_column(String, index=True)
+    path: Mapped[str] = mapped_column(String, doc="the simulation HDF5 file")
+    source: Mapped[str] = mapped_column(String, doc="experimental (lab time-series format) or numerical")
+    protocol: Mapped[str | None] = mapped_column(String, doc="stack or individual (lever)")
+    n: Mapped[int | None] = mapped_column(Integer, index=True, doc="number of driven interfaces / slabs")
+    a: Mapped[int | None] = mapped_column(Integer, doc="slab driven alone (individual protocol)")
+    plates: Mapped[int | None] = mapped_column(Integer, doc="number of elastic plates (fem)")
+    N: Mapped[int | None] = mapped_column(Integer, doc="blocks per interface (fem)")
+    k_drive: Mapped[float | None] = mapped_column(Float, doc="drive spring stiffness (solver units)")
+    regime: Mapped[str | None] = mapped_column(String, index=True, doc="driving regime, e.g. stiff or compliant")
+    seed: Mapped[int | None] = mapped_column(Integer)
+
+
+class SlipEvent(Base):
+    """The slip of one interface in one event, from an analysis output's ``slips`` table."""
+
+    __tablename__ = "slip_events"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
+    analysis_run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), index=True)
+    simulation_run_id: Mapped[str] = mapped_column(String(16), index=True)
+    analysis: Mapped[str] = mapped_column(String, index=True)
+    solver: Mapped[str] = mapped_column(String, index=True)
+    source: Mapped[str | None] = mapped_column(String, index=True,
+                                               doc="numerical or experimental (NULL until its simulation is in)")
+    event: Mapped[int] = mapped_column(Integer, doc="event index within the run")
+    interface: Mapped[int | None] = mapped_column(Integer, index=True, doc="interface (slab) a, 1 = lowest")
+    slip: Mapped[float | None] = mapped_column(Float, doc="slip amplitude (unit in the analysis docs)")
+    time: Mapped[float | None] = mapped_column(Float, doc="time of the event (experimental) [s]")
+    increment: Mapped[int | None] = mapped_column(Integer, doc="increment of the event (numerical)")
+    extra: Mapped[str | None] = mapped_column(Text, doc="the table's other columns, JSON")
+
+
+class Figure(Base):
+    """One figure file pair."""
+
+    __tablename__ = "figures"
+    run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), primary_key=True)
+    figure: Mapped[str] = mapped_column(String, index=True)
+    pdf: Mapped[str] = mapped_column(String)
+    png: Mapped[str | None] = mapped_column(String)
+
+
+Index("ix_slip_events_sim_interface", SlipEvent.simulation_run_id, SlipEvent.interface)
+
+#: Views created with the tables: name -> SELECT.
+VIEWS = {
+    "slip_events_full": (
+        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.N, s.k_drive, s.regime, s.seed "
+        "FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
+}
+
+
+def engine_for(path, *, readonly=False):
+    """Return an SQLAlchemy engine on an SQLite file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    readonly : bool
+        Open with ``mode=ro``: any write raises ``sqlite3.OperationalError``.
+
+    Returns
+    -------
+    sqlalchemy.engine.Engine
+    """
+    if readonly:
+        engine = create_engine(f"sqlite+pysqlite:///file:{path}?mode=ro&uri=true")
+    else:
+        engine = create_engine(f"sqlite+pysqlite:///{path}")
+
+    @event.listens_for(engine, "connect")
+    def _foreign_keys(connection, _record):
+        connection.execute("PRAGMA foreign_keys = ON")
+
+    return engine
+
+
+def create_schema(engine, package_version):
+    """Create the tables and views if missing, and record the schema version.
+
+    Parameters
+    ----------
+    engine : sqlalchemy.engine.Engine
+    package_version : str
+
+    Raises
+    ------
+    FileFormatError
+        If the database has another schema version (it must be rebuilt).
+    """
+    Base.metadata.create_all(engine)
+    with engine.begin() as connection:
+        for name, select in VIEWS.items():
+            connection.execute(text(f"CREATE VIEW IF NOT EXISTS {name} AS {select}"))
+        found = connection.execute(text("SELECT value FROM schema_info WHERE key = 'schema_version'")).scalar()
+        if found is not None and int(found) != SCHEMA_VERSION:
+            raise FileFormatError(f"{engine.url.database}: database schema version {found}, expected {SCHEMA_VERSION}: "
+                               "run `stickslip db rebuild`")
+        connection.execute(text("INSERT OR REPLACE INTO schema_info (key, value) VALUES "
+                                "('schema_version', :v), ('package_version', :p)"),
+                           {"v": str(SCHEMA_VERSION), "p": package_version})

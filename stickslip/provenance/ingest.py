@@ -1,0 +1,230 @@
+"""Ingest provenance records and event tables into the results database.
+
+:func:`ingest` is idempotent (a run is keyed by its run id: ingesting the same
+record twice leaves one set of rows) and transactional: it works on a copy of
+the database in the same directory and renames it into place only when every
+record went in, so an interrupted or failed ingest leaves the previous database
+intact. A lock file beside the database serialises concurrent ingests, so two
+processes ingesting at once lose no record.
+
+What goes where (see :mod:`.database`):
+
+- every record -> ``runs`` and ``artifacts``;
+- solver records -> ``simulations`` (typed columns from the parameters);
+- analysis records -> ``slip_events``, from the ``slips`` table of the output;
+- figure records -> ``figures``.
+"""
+
+import fcntl
+import json
+import os
+import shutil
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+from sqlalchemy import delete, insert, text
+from sqlalchemy.orm import Session
+
+from ..h5io import FileFormatError, open_file, read_table
+from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
+from .record import read_record
+
+__all__ = ["ingest", "find_records", "SLIPS_TABLE", "EVENT_COLUMNS"]
+
+#: Name of the table of slips in an analysis output.
+SLIPS_TABLE = "slips"
+
+#: Columns of a slips table that map to typed columns of ``slip_events``; others go to ``extra``.
+EVENT_COLUMNS = ("event", "interface", "slip", "time", "increment")
+
+SIMULATION_COLUMNS = ("protocol", "n", "a", "plates", "N", "k_drive", "regime", "seed")
+
+#: An event's source is its simulation's (known once both records are in).
+SOURCE_FROM_SIMULATIONS = ("UPDATE slip_events SET source = (SELECT s.source FROM simulations AS s "
+                           "WHERE s.run_id = slip_events.simulation_run_id) WHERE source IS NULL")
+
+
+def find_records(results):
+    """Return every provenance record under a results directory (sorted).
+
+    Parameters
+    ----------
+    results : str or pathlib.Path
+
+    Returns
+    -------
+    list[pathlib.Path]
+
+    Notes
+    -----
+    Cost: one directory walk.
+    """
+    return sorted(Path(results).rglob("*.provenance.json"))
+
+
+@contextmanager
+def _locked(database):
+    lock_path = Path(f"{database}.lock")
+    with open(lock_path, "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+def _beside(record_file, path):
+    """A record's files sit beside it: resolve ``path`` there, whatever the working directory was."""
+    return Path(record_file).parent / Path(path).name
+
+
+def _run_row(record, record_file):
+    versions = record["versions"]
+    return {
+        "run_id": record["run_id"], "kind": record["kind"], "plugin": record["plugin"],
+        "plugin_version": str(record["plugin_version"]), "code_hash": record["code_hash"],
+        "package_version": record["package_version"], "git_commit": record["git_commit"],
+        "git_dirty": record["git_dirty"], "params": json.dumps(record["params"], sort_keys=True),
+        "seed": record["seed"], "threads": record["threads"], "python_version": versions.get("python"),
+        "numpy_version": versions.get("numpy"), "numba_version": versions.get("numba"),
+        "h5py_version": versions.get("h5py"), "versions": json.dumps(versions, sort_keys=True),
+        "host": record["host"], "started_at": record["start"], "finished_at": record["end"],
+        "wall_time_s": record["wall_time_s"], "peak_memory_mib": record["peak_memory_mib"],
+        "record_path": Path(record_file).as_posix(),
+    }
+
+
+def _artifact_rows(record):
+    return [{"run_id": record["run_id"], "direction": direction, "role": entry["role"], "path": entry["path"],
+             "sha256": entry["sha256"], "bytes": entry["bytes"]}
+            for direction, key in (("input", "inputs"), ("output", "outputs")) for entry in record[key]]
+
+
+def _source(simulation_file):
+    """``experimental`` for a file in the experimental time-series format (has ``/t_F``), else ``numerical``."""
+    with open_file(simulation_file) as handle:
+        return "experimental" if "t_F" in handle else "numerical"
+
+
+def _simulation_row(record, record_file):
+    params = record["params"]
+    path = record["outputs"][0]["path"]
+    row = {"run_id": record["run_id"], "solver": record["plugin"], "path": path,
+           "source": _source(_beside(record_file, path))}
+    row.update({column: params.get(column) for column in SIMULATION_COLUMNS})
+    return row
+
+
+def _python(value):
+    """A numpy scalar as the Python scalar SQLite takes."""
+    return value.item() if hasattr(value, "item") else value
+
+
+def _event_rows(record, record_file):
+    output = _beside(record_file, record["outputs"][0]["path"])
+    with open_file(output) as handle:
+        if SLIPS_TABLE not in handle:
+            return []
+        table = read_table(handle, SLIPS_TABLE)
+    simulation = record["inputs"][0]
+    identity = {"analysis_run_id": record["run_id"], "simulation_run_id": Path(simulation["path"]).stem,
+                "analysis": record["plugin"], "solver": simulation["role"].partition(":")[2], "source": None}
+    extra_columns = [c for c in table.columns if c not in EVENT_COLUMNS]
+    rows = []
+    for index, item in enumerate(table.to_dict("records")):
+        row = dict(identity)
+        row.update({column: _python(item.get(column)) for column in EVENT_COLUMNS})
+        if row["event"] is None:
+            row["event"] = index
+        row["extra"] = json.dumps({c: _python(item[c]) for c in extra_columns}) if extra_columns else None
+        rows.append(row)
+    return rows
+
+
+def _figure_row(record):
+    outputs = {entry["role"]: entry["path"] for entry in record["outputs"]}
+    return {"run_id": record["run_id"], "figure": record["plugin"], "pdf": outputs.get("pdf"),
+            "png": outputs.get("png")}
+
+
+def _ingest_record(session, record, record_file):
+    """Replace the rows of one run by those of its record; return the number of slip events added."""
+    run_id = record["run_id"]
+    for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (Artifact, Artifact.run_id),
+                       (Simulation, Simulation.run_id), (Figure, Figure.run_id), (Run, Run.run_id)):
+        session.execute(delete(model).where(key == run_id))
+    session.execute(insert(Run), [_run_row(record, record_file)])
+    artifacts = _artifact_rows(record)
+    if artifacts:
+        session.execute(insert(Artifact), artifacts)
+    events = []
+    if record["kind"] == "solver":
+        session.execute(insert(Simulation), [_simulation_row(record, record_file)])
+    elif record["kind"] == "analysis":
+        events = _event_rows(record, record_file)
+        if events:
+            session.execute(insert(SlipEvent), events)
+    elif record["kind"] == "figure":
+        session.execute(insert(Figure), [_figure_row(record)])
+    return len(events)
+
+
+def ingest(database, records, *, rebuild=False):
+    """Add provenance records (and their event tables) to the database, atomically.
+
+    Parameters
+    ----------
+    database : str or pathlib.Path
+        SQLite file; created if missing.
+    records : Iterable[str or pathlib.Path]
+        Provenance record files (``*.provenance.json``).
+    rebuild : bool
+        Start from an empty database instead of the existing one (the result
+        then holds exactly ``records``).
+
+    Returns
+    -------
+    dict[str, int]
+        Number of ingested ``records``, and rows of ``slip_events`` added.
+
+    Raises
+    ------
+    FileFormatError
+        If a record or an event file is missing or malformed (the message names
+        it); the database is then left as it was.
+
+    Notes
+    -----
+    Cost: reads every record and every analysis output's ``slips`` table; the
+    database is copied once (its size) unless ``rebuild``.
+    """
+    from .. import __version__
+
+    database = Path(database)
+    database.parent.mkdir(parents=True, exist_ok=True)
+    records = [Path(r) for r in records]
+    with _locked(database):
+        fd, tmp = tempfile.mkstemp(prefix=f".{database.name}.", suffix=".tmp", dir=database.parent)
+        os.close(fd)
+        tmp = Path(tmp)
+        try:
+            if database.exists() and not rebuild:
+                shutil.copyfile(database, tmp)
+            else:
+                tmp.unlink()
+            engine = engine_for(tmp)
+            try:
+                create_schema(engine, __version__)
+                events = 0
+                with Session(engine) as session, session.begin():
+                    for record_file in records:
+                        events += _ingest_record(session, read_record(record_file), record_file)
+                    session.execute(text(SOURCE_FROM_SIMULATIONS))
+            finally:
+                engine.dispose()
+            os.replace(tmp, database)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
+    return {"records": len(records), "slip events": events}

@@ -1,0 +1,149 @@
+"""Read the results database into pandas DataFrames (read-only connections).
+
+Every function opens the SQLite file read-only (``mode=ro``), so a query can
+never change it, and returns a :class:`pandas.DataFrame`. Filters left at
+``None`` are not applied.
+"""
+
+from pathlib import Path
+
+import pandas as pd
+from sqlalchemy import select, text
+
+from ..h5io import FileFormatError
+from .database import Figure, Run, Simulation, SlipEvent, engine_for
+
+__all__ = ["DEFAULT_DATABASE", "runs", "events", "figures", "sql"]
+
+#: Where the workflow writes the database (relative to the workflow directory).
+DEFAULT_DATABASE = "results/stickslip.sqlite"
+
+
+def _engine(database):
+    path = Path(database)
+    if not path.is_file():
+        raise FileFormatError(f"{path}: no such database (run the workflow, or `stickslip db rebuild`)")
+    return engine_for(path, readonly=True)
+
+
+def _frame(database, statement):
+    engine = _engine(database)
+    try:
+        with engine.connect() as connection:
+            return pd.read_sql(statement, connection)
+    finally:
+        engine.dispose()
+
+
+def _where(statement, filters):
+    for column, value in filters:
+        if value is not None:
+            statement = statement.where(column == value)
+    return statement
+
+
+def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=None, regime=None, seed=None):
+    """Return the runs, with their simulation parameters where they are simulations.
+
+    Parameters
+    ----------
+    database : str or pathlib.Path
+    kind : {"solver", "analysis", "figure", "mesh"}, optional
+    plugin : str, optional
+    solver : str, optional
+        Only simulations of this solver.
+    n : int, optional
+        Only simulations with this number of driven interfaces.
+    regime : str, optional
+        Only simulations in this driving regime.
+    seed : int, optional
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run: the ``runs`` columns, then ``solver``, ``source``,
+        ``protocol``, ``n``, ``a``, ``plates``, ``N``, ``k_drive``, ``regime``
+        (NULL for runs that are not simulations); ordered by kind, plugin, run id.
+
+    Notes
+    -----
+    Cost: one indexed query; linear in the number of runs returned.
+    """
+    columns = [Simulation.solver, Simulation.source, Simulation.protocol, Simulation.n, Simulation.a,
+               Simulation.plates, Simulation.N, Simulation.k_drive, Simulation.regime]
+    statement = (select(Run, *columns).outerjoin(Simulation, Simulation.run_id == Run.run_id)
+                 .order_by(Run.kind, Run.plugin, Run.run_id))
+    statement = _where(statement, [(Run.kind, kind), (Run.plugin, plugin), (Simulation.solver, solver),
+                                   (Simulation.n, n), (Simulation.regime, regime), (Run.seed, seed)])
+    return _frame(database, statement)
+
+
+def events(database=DEFAULT_DATABASE, *, solver=None, analysis=None, source=None, n=None, interface=None,
+           regime=None, seed=None, run_id=None):
+    """Return slip events with the parameters of their simulation.
+
+    Parameters
+    ----------
+    database : str or pathlib.Path
+    solver, analysis : str, optional
+    source : {"numerical", "experimental"}, optional
+    n : int, optional
+        Number of driven interfaces of the simulation.
+    interface : int, optional
+        Interface (slab) ``a`` (1 = lowest).
+    regime : str, optional
+    seed : int, optional
+    run_id : str, optional
+        Only the events of this simulation.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The ``slip_events_full`` view: one row per slip of one interface in one
+        event, with ``protocol``, ``n``, ``a``, ``plates``, ``N``, ``k_drive``,
+        ``regime``, ``seed``; ordered by simulation, event, interface.
+
+    Notes
+    -----
+    Cost: one query using the indexes on solver, interface and simulation;
+    linear in the number of events returned (a paper-size study has ~10^5-10^6).
+    """
+    conditions = {"solver": solver, "analysis": analysis, "source": source, "n": n, "interface": interface,
+                  "regime": regime, "seed": seed, "simulation_run_id": run_id}
+    used = {key: value for key, value in conditions.items() if value is not None}
+    where = " AND ".join(f"{key} = :{key}" for key in used)
+    statement = text("SELECT * FROM slip_events_full" + (f" WHERE {where}" if where else "")
+                     + " ORDER BY simulation_run_id, event, interface").bindparams(**used)
+    return _frame(database, statement)
+
+
+def figures(database=DEFAULT_DATABASE):
+    """Return the figures with the run that drew them (plugin version, code hash, time).
+
+    Notes
+    -----
+    Cost: one query; one row per figure.
+    """
+    statement = (select(Figure, Run.plugin_version, Run.code_hash, Run.finished_at, Run.git_commit)
+                 .join(Run, Run.run_id == Figure.run_id).order_by(Figure.figure))
+    return _frame(database, statement)
+
+
+def sql(query, database=DEFAULT_DATABASE):
+    """Run any SQL on a read-only connection and return the result.
+
+    Parameters
+    ----------
+    query : str
+        One SQL statement (``SELECT ...``); writes fail (read-only connection).
+    database : str or pathlib.Path
+
+    Returns
+    -------
+    pandas.DataFrame
+
+    Notes
+    -----
+    Cost: whatever the query costs; the indexes are listed in docs/database.md.
+    """
+    return _frame(database, text(query))

@@ -1,0 +1,251 @@
+"""Provenance records: one JSON file beside every output of the workflow.
+
+A record says what made a file and how: the plugin and its version, the code
+hash, the package version and git commit, every parameter, the seed, the
+library versions, the host, the start and end time, the wall time, the peak
+memory, and the inputs and outputs with their sha256. It is written under a
+temporary name and renamed into place, so a reader never sees half a record.
+
+The record of ``results/sim/lever/0123456789abcdef.h5`` is
+``results/sim/lever/0123456789abcdef.provenance.json`` (:func:`record_path`).
+"""
+
+import datetime
+import hashlib
+import json
+import platform
+import resource
+import socket
+import subprocess
+import sys
+import time
+from contextlib import contextmanager
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+from ..h5io import FileFormatError, atomic_output
+
+__all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "sha256_file", "file_entry", "git_state",
+           "library_versions", "write_record", "read_record", "Recorder", "recording"]
+
+#: Version of the record layout; bump when fields change meaning.
+SCHEMA_VERSION = 1
+
+#: Fields every record has (values may be null where not applicable, e.g. ``seed``).
+REQUIRED_FIELDS = ("schema_version", "run_id", "kind", "plugin", "plugin_version", "code_hash",
+                   "package_version", "git_commit", "git_dirty", "params", "seed", "threads",
+                   "versions", "host", "start", "end", "wall_time_s", "peak_memory_mib", "inputs", "outputs")
+
+LIBRARIES = ("numpy", "numba", "h5py", "pandas", "matplotlib", "sqlalchemy", "snakemake")
+
+_CHUNK = 1 << 20
+
+
+def record_path(output):
+    """Return the record path of an output file: same stem, suffix ``.provenance.json``.
+
+    Parameters
+    ----------
+    output : str or pathlib.Path
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    return Path(output).with_suffix(".provenance.json")
+
+
+def sha256_file(path):
+    """Return the sha256 (hex) of a file's bytes, read in 1 MiB chunks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        while chunk := stream.read(_CHUNK):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def file_entry(role, path):
+    """Describe one input or output file.
+
+    Parameters
+    ----------
+    role : str
+        What the file is to the job (``"output"``, ``"mesh"``, ``"solver:lever"``, ...).
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    dict
+        ``{"role", "path", "sha256", "bytes"}``.
+
+    Raises
+    ------
+    FileFormatError
+        If the file does not exist.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileFormatError(f"{path}: no such file (expected as {role})")
+    return {"role": role, "path": path.as_posix(), "sha256": sha256_file(path), "bytes": path.stat().st_size}
+
+
+def git_state(directory=None):
+    """Return the git commit and dirty flag of the repository holding the package.
+
+    Parameters
+    ----------
+    directory : str or pathlib.Path, optional
+        Where to ask git; default: the package's source directory.
+
+    Returns
+    -------
+    tuple[str | None, bool | None]
+        Commit hash and whether tracked files differ from it; ``(None, None)`` if
+        the package is not in a git working tree (e.g. installed from a wheel).
+    """
+    directory = Path(directory or Path(__file__).resolve().parent.parent)
+
+    def git(*args):
+        return subprocess.run(["git", "-C", str(directory), *args], capture_output=True, text=True,
+                              check=True, timeout=30).stdout.strip()
+
+    try:
+        commit = git("rev-parse", "HEAD")
+        dirty = bool(git("status", "--porcelain", "--untracked-files=no"))
+    except (OSError, subprocess.SubprocessError):
+        return None, None
+    return commit, dirty
+
+
+def library_versions():
+    """Return the versions of Python and of the libraries that shape results.
+
+    Returns
+    -------
+    dict[str, str | None]
+        ``python``, ``platform`` and each of :data:`LIBRARIES` (None if not installed).
+    """
+    versions = {"python": platform.python_version(), "platform": platform.platform()}
+    for name in LIBRARIES:
+        try:
+            versions[name] = version(name)
+        except PackageNotFoundError:
+            versions[name] = None
+    return versions
+
+
+def _package_version():
+    from .. import __version__
+
+    return __version__
+
+
+def _now():
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="milliseconds")
+
+
+def peak_memory_mib():
+    """Return the peak resident memory of this process so far [MiB] (Linux ``ru_maxrss``)."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (1024.0 * 1024.0) if sys.platform == "darwin" else peak / 1024.0
+
+
+def write_record(path, record):
+    """Write a record as JSON, atomically (temporary file, then rename).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    record : dict
+    """
+    with atomic_output(path) as tmp:
+        tmp.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+
+
+def read_record(path):
+    """Read and check a record.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    FileFormatError
+        If the file is missing, not JSON, or lacks a field of :data:`REQUIRED_FIELDS`.
+    """
+    path = Path(path)
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise FileFormatError(f"{path}: no such provenance record") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise FileFormatError(f"{path}: not a valid provenance record (bad JSON: {error})") from None
+    if not isinstance(record, dict):
+        raise FileFormatError(f"{path}: not a valid provenance record (expected a JSON object)")
+    missing = [field for field in REQUIRED_FIELDS if field not in record]
+    if missing:
+        raise FileFormatError(f"{path}: provenance record lacks {', '.join(missing)}")
+    if record["schema_version"] != SCHEMA_VERSION:
+        raise FileFormatError(f"{path}: provenance schema_version {record['schema_version']!r}, "
+                              f"expected {SCHEMA_VERSION}")
+    return record
+
+
+class Recorder:
+    """Collects what a job did; :func:`recording` creates one and writes its record.
+
+    Attributes
+    ----------
+    record : dict
+        The record being filled; ``outputs`` are added on success.
+    """
+
+    def __init__(self, *, run_id, kind, plugin, plugin_version, code_hash, params, threads=1, inputs=()):
+        commit, dirty = git_state()
+        self.record = {
+            "schema_version": SCHEMA_VERSION, "run_id": run_id, "kind": kind, "plugin": plugin,
+            "plugin_version": plugin_version, "code_hash": code_hash, "package_version": _package_version(),
+            "git_commit": commit, "git_dirty": dirty, "params": params, "seed": params.get("seed"),
+            "threads": threads, "versions": library_versions(), "host": socket.gethostname(),
+            "inputs": [file_entry(role, path) for role, path in inputs],
+        }
+
+
+@contextmanager
+def recording(record_file, outputs, **identity):
+    """Time a job and write its provenance record when it succeeds.
+
+    Parameters
+    ----------
+    record_file : str or pathlib.Path
+        Where the record goes (see :func:`record_path`).
+    outputs : Sequence[tuple[str, str | pathlib.Path]]
+        ``(role, path)`` of each file the job writes; hashed after the job.
+    **identity
+        Keyword arguments of :class:`Recorder` (run_id, kind, plugin, ...).
+
+    Yields
+    ------
+    Recorder
+        Its ``record`` may be extended by the job before the block ends.
+
+    Notes
+    -----
+    Nothing is written if the block raises, so a failed job leaves no record.
+    Inputs are hashed before the job starts (a missing input fails early).
+    """
+    recorder = Recorder(**identity)
+    start_clock, start = time.perf_counter(), _now()
+    yield recorder
+    wall = time.perf_counter() - start_clock
+    recorder.record.update({
+        "start": start, "end": _now(), "wall_time_s": round(wall, 6),
+        "peak_memory_mib": round(peak_memory_mib(), 3),
+        "outputs": [file_entry(role, path) for role, path in outputs],
+    })
+    write_record(record_file, recorder.record)

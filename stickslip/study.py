@@ -1,0 +1,334 @@
+"""The study: a workflow config turned into the jobs that the rules run.
+
+Config layout (``workflow/config/*.yaml``, schema ``workflow/schemas/config.schema.yaml``)::
+
+    threads: 1                      # numba threads of each simulation job
+    solvers:                        # solver name -> list of sweeps
+      lever:
+        - params: {protocol: stack} # shared by the sweep's runs (defaults filled)
+          grid: {n: [1, 2], seed: [1, 2, 3]}   # every combination is one run
+    analyses:                       # analysis name -> parameters
+      experiment-events: {}
+    figures:                        # figure name -> parameters
+      fig3: {}
+
+A run's parameters are its sweep's ``params`` overridden by one combination of
+its ``grid``; its id is :func:`stickslip.registry.run_id` of those parameters.
+An analysis runs on every simulation of the solvers it accepts; a figure reads
+every output of each input category it declares (``solver:<name>``,
+``analysis:<name>``, ``mesh``). Paths follow :data:`PATHS`.
+"""
+
+import dataclasses
+import itertools
+import json
+
+from . import registry
+from .params import ParameterError, json_schema, params_to_dict, parse_params
+from .provenance.code import code_hash
+from .provenance.record import record_path
+
+__all__ = ["PATHS", "Simulation", "AnalysisJob", "FigureJob", "Study", "plugin_sections", "normalise"]
+
+#: Output path patterns (relative to the workflow's working directory).
+PATHS = {
+    "mesh": "results/mesh/{mesh_id}.h5",
+    "simulation": "results/sim/{solver}/{run_id}.h5",
+    "events": "results/events/{analysis}/{solver}/{run_id}.h5",
+    "figure": "results/figures/{figure}.pdf",
+    "database": "results/stickslip.sqlite",
+}
+
+SECTIONS = {"solvers": "solver", "analyses": "analysis", "figures": "figure"}
+
+
+@dataclasses.dataclass(frozen=True)
+class Simulation:
+    """One solver run.
+
+    Attributes
+    ----------
+    solver : str
+    run_id : str
+    params : dict
+        Defaults-filled, JSON-safe parameters.
+    mesh_id : str or None
+        Id of the mesh file it reads (solvers that declare the ``"mesh"`` input).
+    """
+
+    solver: str
+    run_id: str
+    params: dict
+    mesh_id: str | None = None
+
+    @property
+    def path(self):
+        """Output file."""
+        return PATHS["simulation"].format(solver=self.solver, run_id=self.run_id)
+
+
+@dataclasses.dataclass(frozen=True)
+class AnalysisJob:
+    """One analysis of one simulation output."""
+
+    analysis: str
+    simulation: Simulation
+
+    @property
+    def path(self):
+        """Output file."""
+        return PATHS["events"].format(analysis=self.analysis, solver=self.simulation.solver,
+                                      run_id=self.simulation.run_id)
+
+
+@dataclasses.dataclass(frozen=True)
+class FigureJob:
+    """One figure and the files it reads.
+
+    Attributes
+    ----------
+    figure : str
+    params : dict
+    inputs : dict[str, list[str]]
+        Input category -> sorted paths.
+    """
+
+    figure: str
+    params: dict
+    inputs: dict
+
+    @property
+    def path(self):
+        """Output PDF (the PNG is beside it)."""
+        return PATHS["figure"].format(figure=self.figure)
+
+
+def _where(section, name, *rest):
+    return ".".join([section, name]) + "".join(rest)
+
+
+def normalise(config):
+    """Replace empty plugin sections (``fig3:`` with no value) by ``{}``, in place.
+
+    Parameters
+    ----------
+    config : dict
+        The workflow config (already checked against the config schema).
+    """
+    for section in ("analyses", "figures"):
+        for name, values in (config.get(section) or {}).items():
+            if values is None:
+                config[section][name] = {}
+
+
+def _grid_schema(params_cls):
+    properties = {}
+    for name, prop in json_schema(params_cls)["properties"].items():
+        item = {k: v for k, v in prop.items() if k not in ("default", "description")}
+        properties[name] = {"type": "array", "items": item, "minItems": 1,
+                            "description": f"values of {name} to sweep over"}
+    return {"type": "object", "properties": properties, "additionalProperties": False}
+
+
+def _plugin(kind, name, where):
+    try:
+        return registry.get(kind, name)
+    except registry.PluginError as error:
+        raise ParameterError(f"config {where}: {error}") from None
+
+
+def plugin_sections(config):
+    """List the config sections that hold a plugin's parameters, with their JSON-Schema.
+
+    Parameters
+    ----------
+    config : dict
+        The workflow config (normalised, see :func:`normalise`).
+
+    Returns
+    -------
+    list[tuple[str, dict, dict]]
+        ``(key, section, schema)``: ``key`` names the section in messages (e.g.
+        ``solvers.lever[0].grid``); ``section`` is the mapping itself (a schema
+        validator that fills defaults changes it in place); ``schema`` comes from
+        :func:`stickslip.params.json_schema` of the plugin's parameter class.
+
+    Raises
+    ------
+    ParameterError
+        If a plugin name is unknown; the message names the key and lists the plugins.
+    """
+    sections = []
+    for section, kind in SECTIONS.items():
+        for name, values in (config.get(section) or {}).items():
+            plugin = _plugin(kind, name, _where(section, name))
+            if kind == "solver":
+                for i, sweep in enumerate(values):
+                    sections.append((_where(section, name, f"[{i}].params"), sweep["params"],
+                                     json_schema(plugin.params)))
+                    sections.append((_where(section, name, f"[{i}].grid"), sweep["grid"],
+                                     _grid_schema(plugin.params)))
+            else:
+                sections.append((_where(section, name), values, json_schema(plugin.params)))
+    return sections
+
+
+def _parse(plugin, values, where):
+    try:
+        return parse_params(plugin.params, values, owner=f"{plugin.kind} '{plugin.name}'")
+    except ParameterError as error:
+        raise ParameterError(f"config {where}: {error}") from None
+
+
+def _mesh_for(params):
+    """Return (mesh_id, mesh parameters) for a solver run: the solver's fields named as MeshParams fields."""
+    from . import mesh
+
+    fields = {f.name for f in dataclasses.fields(mesh.MeshParams)}
+    mesh_params = parse_params(mesh.MeshParams, {k: v for k, v in params.items() if k in fields}, owner="mesh")
+    return mesh.mesh_id(mesh_params), params_to_dict(mesh_params)
+
+
+class Study:
+    """All jobs of one workflow config.
+
+    Parameters
+    ----------
+    config : dict
+        The workflow config, checked against the schema (see :func:`plugin_sections`).
+
+    Raises
+    ------
+    ParameterError
+        For a bad parameter value, an unknown plugin, a solver input category
+        that the workflow cannot make, an analysis or figure whose inputs the
+        study does not produce; the message names the config key.
+
+    Attributes
+    ----------
+    threads : int
+    simulations : list[Simulation]
+        Sorted by solver, then run id; no duplicates.
+    meshes : dict[str, dict]
+        Mesh id -> mesh parameters.
+    analyses : dict[str, dict]
+        Analysis name -> parameters.
+    analysis_jobs : list[AnalysisJob]
+    figures : dict[str, FigureJob]
+    """
+
+    def __init__(self, config):
+        normalise(config)
+        self.threads = int(config.get("threads", 1))
+        self.meshes = {}
+        self.simulations = self._simulations(config.get("solvers") or {})
+        self.analyses, self.analysis_jobs = self._analyses(config.get("analyses") or {})
+        self.figures = self._figures(config.get("figures") or {})
+
+    def _simulations(self, solvers):
+        runs = {}
+        for name, sweeps in solvers.items():
+            plugin = _plugin("solver", name, _where("solvers", name))
+            unknown = sorted(set(plugin.inputs) - {"mesh"})
+            if unknown:
+                raise ParameterError(f"config solvers.{name}: the workflow cannot make the input(s) "
+                                     f"{', '.join(unknown)} that solver '{name}' declares (it makes: mesh)")
+            for i, sweep in enumerate(sweeps):
+                grid = sweep.get("grid") or {}
+                keys = list(grid)
+                for combination in itertools.product(*(grid[k] for k in keys)):
+                    values = {**(sweep.get("params") or {}), **dict(zip(keys, combination))}
+                    params = _parse(plugin, values, _where("solvers", name, f"[{i}]"))
+                    run = registry.run_id(plugin, params)
+                    as_dict = params_to_dict(params)
+                    mesh_id = None
+                    if "mesh" in plugin.inputs:
+                        mesh_id, mesh_params = _mesh_for(as_dict)
+                        self.meshes[mesh_id] = mesh_params
+                    runs[(name, run)] = Simulation(name, run, as_dict, mesh_id)
+        return [runs[key] for key in sorted(runs)]
+
+    def _analyses(self, analyses):
+        chosen, jobs = {}, []
+        for name, values in analyses.items():
+            plugin = _plugin("analysis", name, _where("analyses", name))
+            chosen[name] = params_to_dict(_parse(plugin, values, _where("analyses", name)))
+            mine = [AnalysisJob(name, sim) for sim in self.simulations if sim.solver in plugin.inputs]
+            if not mine:
+                raise ParameterError(f"config analyses.{name}: it reads outputs of the solver(s) "
+                                     f"{', '.join(plugin.inputs) or '(none)'}, which the study does not run")
+            jobs.extend(mine)
+        return chosen, jobs
+
+    def _category_paths(self, category):
+        kind, _, name = category.partition(":")
+        if category == "mesh":
+            return [PATHS["mesh"].format(mesh_id=m) for m in sorted(self.meshes)]
+        if kind == "solver":
+            return [sim.path for sim in self.simulations if sim.solver == name]
+        if kind == "analysis":
+            return [job.path for job in self.analysis_jobs if job.analysis == name]
+        return None
+
+    def _figures(self, figures):
+        jobs = {}
+        for name, values in figures.items():
+            plugin = _plugin("figure", name, _where("figures", name))
+            params = params_to_dict(_parse(plugin, values, _where("figures", name)))
+            inputs = {}
+            for category in plugin.inputs:
+                paths = self._category_paths(category)
+                if paths is None:
+                    raise ParameterError(f"config figures.{name}: unknown input category {category!r} "
+                                         "(expected 'mesh', 'solver:<name>' or 'analysis:<name>')")
+                if not paths:
+                    raise ParameterError(f"config figures.{name}: it reads {category} outputs, which the "
+                                         "study does not produce (add the solver or analysis to the config)")
+                inputs[category] = sorted(paths)
+            jobs[name] = FigureJob(name, params, inputs)
+        return jobs
+
+    # Look-ups used by the rules ------------------------------------------------------------
+
+    def simulation(self, solver, run_id):
+        """Return the :class:`Simulation` with this solver and run id (KeyError if none)."""
+        for sim in self.simulations:
+            if sim.solver == solver and sim.run_id == run_id:
+                return sim
+        raise KeyError(f"no simulation {solver}/{run_id} in the study")
+
+    def solver_inputs(self, solver, run_id):
+        """Return the upstream files of one simulation, by category (``{"mesh": path}`` or ``{}``)."""
+        sim = self.simulation(solver, run_id)
+        return {} if sim.mesh_id is None else {"mesh": PATHS["mesh"].format(mesh_id=sim.mesh_id)}
+
+    def outputs(self):
+        """Return every output file of the study except the database (sorted)."""
+        paths = [PATHS["mesh"].format(mesh_id=m) for m in self.meshes]
+        paths += [sim.path for sim in self.simulations]
+        paths += [job.path for job in self.analysis_jobs]
+        for job in self.figures.values():
+            paths += [job.path, job.path.replace(".pdf", ".png")]
+        return sorted(paths)
+
+    def records(self):
+        """Return the provenance record of every job (sorted): the database rule's input."""
+        paths = [PATHS["mesh"].format(mesh_id=m) for m in self.meshes]
+        paths += [sim.path for sim in self.simulations]
+        paths += [job.path for job in self.analysis_jobs]
+        paths += [job.path for job in self.figures.values()]
+        return sorted(record_path(p).as_posix() for p in paths)
+
+    @staticmethod
+    def code(kind, name):
+        """Return the code hash of a plugin (``kind`` "mesh" for the mesh writer)."""
+        if kind == "mesh":
+            from .mesh import write_mesh
+
+            return code_hash(write_mesh.__module__)
+        return code_hash(registry.get(kind, name).module)
+
+    @staticmethod
+    def dumps(params):
+        """Return parameters as canonical JSON (what the rules pass to the jobs)."""
+        return json.dumps(params, sort_keys=True)

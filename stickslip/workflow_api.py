@@ -1,0 +1,228 @@
+"""The jobs of the Snakemake workflow: each runs one plugin and writes its provenance record.
+
+The scripts in ``workflow/scripts/`` are one call each to a function of this
+module, so everything a rule does can be run and tested without Snakemake.
+Every function writes a log, checks that its input files are readable HDF5
+(a corrupted file is reported by name before any work), runs the plugin, and
+writes the JSON record beside the output (:mod:`stickslip.provenance.record`).
+
+This module imports nothing that imports numba: :func:`prepare_environment`
+must set the numba variables before the first plugin is loaded.
+"""
+
+import contextlib
+import hashlib
+import json
+import os
+import sys
+import tempfile
+import traceback
+from pathlib import Path
+
+from . import registry
+from .h5io import FileFormatError, open_file
+from .params import params_to_dict, parse_params
+from .provenance.code import code_hash
+from .provenance.record import recording, sha256_file
+
+__all__ = ["prepare_environment", "run_mesh", "run_simulation", "run_analysis", "run_figure", "build_database"]
+
+
+def prepare_environment(threads, numba_cache=""):
+    """Set the numba environment of a job; call before anything imports numba.
+
+    Parameters
+    ----------
+    threads : int
+        The rule's threads: ``NUMBA_NUM_THREADS`` (numba's thread pool size).
+    numba_cache : {"", "job"}
+        ``"job"``: compile into a fresh cache directory of this job under
+        ``$TMPDIR`` (``NUMBA_CACHE_DIR``), as on a cluster where many jobs share
+        one file system; ``""``: numba's default cache beside the sources.
+
+    Returns
+    -------
+    str or None
+        The job's cache directory, if one was made.
+    """
+    if threads < 1:
+        raise ValueError(f"threads must be >= 1, got {threads}")
+    if "numba" in sys.modules:
+        raise RuntimeError("prepare_environment must run before numba is imported")
+    os.environ["NUMBA_NUM_THREADS"] = str(int(threads))
+    if numba_cache == "job":
+        cache = tempfile.mkdtemp(prefix="stickslip-numba-")
+        os.environ["NUMBA_CACHE_DIR"] = cache
+        return cache
+    if numba_cache:
+        raise ValueError(f"numba_cache must be '' or 'job', got {numba_cache!r}")
+    return None
+
+
+@contextlib.contextmanager
+def _logged(log):
+    """Send stdout and stderr to ``log``; a failure's traceback goes there too, then propagates."""
+    Path(log).parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w", encoding="utf-8") as stream:
+        try:
+            with contextlib.redirect_stdout(stream), contextlib.redirect_stderr(stream):
+                yield stream
+        except BaseException:
+            stream.write(traceback.format_exc())
+            raise
+
+
+def _check_hdf5(role, path):
+    """Open an input once so that an unreadable or truncated file is reported by name."""
+    try:
+        with open_file(path) as handle:
+            handle.attrs.keys()
+    except FileFormatError as error:
+        raise FileFormatError(f"{error} (input {role})") from None
+    except OSError as error:  # h5py reports damaged content on first access
+        raise FileFormatError(f"{path}: damaged HDF5 file ({error}) (input {role})") from None
+
+
+def _derived_run_id(plugin, params, input_files):
+    """Id of an analysis or figure run: plugin identity, parameters and the inputs' bytes."""
+    digest = hashlib.sha256(registry.run_id(plugin, params).encode())
+    for path in sorted(input_files):
+        digest.update(sha256_file(path).encode())
+    return digest.hexdigest()[:16]
+
+
+def _load(kind, name, params_json):
+    plugin = registry.get(kind, name)
+    params = parse_params(plugin.params, json.loads(params_json), owner=f"{kind} '{name}'")
+    return plugin, params
+
+
+def run_mesh(params_json, output, record, log):
+    """Write one mesh file.
+
+    Parameters
+    ----------
+    params_json : str
+        :class:`stickslip.mesh.MeshParams` values as JSON.
+    output, record, log : str or pathlib.Path
+        Mesh file (HDF5), its provenance record, the log.
+    """
+    prepare_environment(1)
+    with _logged(log):
+        from . import mesh
+
+        params = parse_params(mesh.MeshParams, json.loads(params_json), owner="mesh")
+        as_dict = params_to_dict(params)
+        with recording(record, [("output", output)], run_id=mesh.mesh_id(params), kind="mesh", plugin="mesh",
+                       plugin_version=code_hash(mesh.write_mesh.__module__),
+                       code_hash=code_hash(mesh.write_mesh.__module__), params=as_dict):
+            print(f"mesh {json.dumps(as_dict, sort_keys=True)} -> {output}")
+            mesh.write_mesh(params, Path(output))
+
+
+def run_simulation(solver, params_json, output, record, log, *, inputs, threads, numba_cache=""):
+    """Run one solver.
+
+    Parameters
+    ----------
+    solver : str
+        Solver plugin name.
+    params_json : str
+        Its parameters as JSON (defaults may be missing; they are filled).
+    output, record, log : str or pathlib.Path
+        Simulation file (HDF5), its provenance record, the log.
+    inputs : Mapping[str, str]
+        Upstream files by declared category (e.g. ``{"mesh": path}``).
+    threads : int
+        Threads of the parallel kernels.
+    numba_cache : {"", "job"}
+        See :func:`prepare_environment`.
+    """
+    prepare_environment(threads, numba_cache)
+    with _logged(log):
+        from .numba_options import set_num_threads
+
+        plugin, params = _load("solver", solver, params_json)
+        for role, path in inputs.items():
+            _check_hdf5(role, path)
+        used = set_num_threads(threads)
+        as_dict = params_to_dict(params)
+        with recording(record, [("output", output)], run_id=registry.run_id(plugin, params), kind="solver",
+                       plugin=plugin.name, plugin_version=plugin.version, code_hash=code_hash(plugin.module),
+                       params=as_dict, threads=used, inputs=sorted(inputs.items())):
+            print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(as_dict, sort_keys=True)}")
+            plugin.run(params, Path(output), threads=used, inputs={k: Path(v) for k, v in inputs.items()})
+
+
+def run_analysis(analysis, params_json, input, output, record, log):
+    """Run one analysis on one simulation output.
+
+    Parameters
+    ----------
+    analysis : str
+        Analysis plugin name.
+    params_json : str
+        Its parameters as JSON.
+    input : str or pathlib.Path
+        The simulation file.
+    output, record, log : str or pathlib.Path
+        Table file (HDF5), its provenance record, the log.
+    """
+    prepare_environment(1)
+    with _logged(log):
+        plugin, params = _load("analysis", analysis, params_json)
+        _check_hdf5("simulation", input)
+        role = f"solver:{Path(input).parent.name}"
+        with recording(record, [("output", output)], run_id=_derived_run_id(plugin, params, [input]),
+                       kind="analysis", plugin=plugin.name, plugin_version=plugin.version,
+                       code_hash=code_hash(plugin.module), params=params_to_dict(params), inputs=[(role, input)]):
+            print(f"analysis {plugin.name} {plugin.version} on {input}")
+            plugin.run(params, Path(input), Path(output))
+
+
+def run_figure(figure, params_json, inputs_json, output, record, log):
+    """Draw one figure.
+
+    Parameters
+    ----------
+    figure : str
+        Figure plugin name.
+    params_json : str
+        Its parameters as JSON.
+    inputs_json : str
+        JSON object: input category -> list of paths.
+    output, record, log : str or pathlib.Path
+        The PDF (the PNG goes beside it), the provenance record, the log.
+    """
+    prepare_environment(1)
+    with _logged(log):
+        plugin, params = _load("figure", figure, params_json)
+        inputs = json.loads(inputs_json)
+        files = [(category, path) for category, paths in sorted(inputs.items()) for path in paths]
+        for role, path in files:
+            _check_hdf5(role, path)
+        output = Path(output)
+        outputs = [("pdf", output), ("png", output.with_suffix(".png"))]
+        with recording(record, outputs, run_id=_derived_run_id(plugin, params, [p for _, p in files]),
+                       kind="figure", plugin=plugin.name, plugin_version=plugin.version,
+                       code_hash=code_hash(plugin.module), params=params_to_dict(params), inputs=files):
+            print(f"figure {plugin.name} {plugin.version} from {len(files)} file(s)")
+            plugin.run(params, {k: [Path(p) for p in v] for k, v in inputs.items()}, output)
+
+
+def build_database(records, database, log):
+    """Build the results database from the study's records (the database rule).
+
+    Parameters
+    ----------
+    records : Sequence[str or pathlib.Path]
+        Provenance records of every job of the study.
+    database : str or pathlib.Path
+        SQLite file; replaced atomically, so a failure leaves the previous one.
+    log : str or pathlib.Path
+    """
+    with _logged(log):
+        from .provenance.ingest import ingest
+
+        counts = ingest(database, records, rebuild=True)
+        print("ingested " + ", ".join(f"{count} {name}" for name, count in counts.items()))
