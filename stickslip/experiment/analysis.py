@@ -51,6 +51,8 @@ class ExperimentEventsParams:
     t_exclude: float = param(300.0, "initial transient excluded from the tables (from the first frame)",
                              unit="s", minimum=0)
     t0: float = param(aging.T0, "time scale T0 of the aging law dmu = B ln(T/T0)", unit="s", exclusive_minimum=0)
+    position_frames: int = param(detection.POSITION_FRAMES, "frames averaged for the position of an interface "
+                                 "before and after a slip", unit="frames", minimum=1)
     slow_slip_drift: float = param(aging.SLOW_SLIP_DRIFT, "drift of an interface between two of its slips "
                                    "above which slow slip occurred", unit="mm", minimum=0)
 
@@ -87,16 +89,17 @@ def analyse_record(record, params=ExperimentEventsParams()):
         kinematics of a single slip does not apply), ``t_start``, ``t_end`` [s] (frames that
         bracket the slip), ``dF`` [N] (force drop of the event), ``dmu`` [-]
         (:func:`~stickslip.experiment.kinematics.dmu_from_dF`), ``T`` [s] (since the previous slip
-        of interface ``a``; NaN for its first), ``dR`` [mm] (measured), ``dR_from_dF`` [mm]
+        of interface ``a``; NaN for its first), ``dR`` [mm] (measured, see
+        :func:`~stickslip.experiment.detection.detect_slips`), ``dR_from_dF`` [mm]
         (:func:`~stickslip.experiment.kinematics.dR_from_dF`), ``B_a``
-        (``dmu / ln(T / T0)``), ``drift`` [mm] (``R_a`` at ``t_start`` minus ``R_a`` at the end of
-        the previous slip of ``a``), ``slow_slip_before`` (``drift >= slow_slip_drift``).
+        (``dmu / ln(T / T0)``), ``drift`` [mm] (``R_a`` just before the slip minus ``R_a`` just
+        after the previous slip of ``a``, both averaged over ``position_frames`` frames), ``slow_slip_before`` (``drift >= slow_slip_drift``).
     interfaces : pandas.DataFrame
         Columns ``a``, ``R_tot``, ``dR_sum`` [mm], ``R_slow`` [-], ``n_slips``, ``n_multi``.
     """
     R = record.R
     slips = detection.detect_slips(record.t_x, R, threshold=params.threshold, width=params.average_frames,
-                                   min_frames=params.min_frames)
+                                   min_frames=params.min_frames, position_frames=params.position_frames)
     t_start, t_end, previous, following = _event_windows(slips)
     event_dF = detection.force_drop(record.t_F, record.F, t_start, t_end, window=params.force_window,
                                     t_previous=previous, t_next=following)
@@ -112,12 +115,7 @@ def analyse_record(record, params=ExperimentEventsParams()):
     slips = slips.sort_values(["a", "t"], kind="stable")
     by_interface = slips.groupby("a")
     slips["T"] = slips["t"] - by_interface["t"].shift()
-    column = slips["a"].to_numpy() - 1
-    end_of_previous = by_interface["i_end"].shift()
-    has_previous = end_of_previous.notna().to_numpy()
-    previous_index = end_of_previous.fillna(0).to_numpy(dtype=int)
-    drift = R[slips["i_start"].to_numpy(), column] - R[previous_index, column]
-    slips["drift"] = np.where(has_previous, drift, np.nan)
+    slips["drift"] = slips["R_before"] - by_interface["R_after"].shift()
     slips["slow_slip_before"] = slips["drift"].to_numpy() >= params.slow_slip_drift
     slips["B_a"] = aging.aging_rate(slips["dmu"], slips["T"], t0=params.t0)
     slips["n"] = int(record.n)

@@ -9,8 +9,11 @@ Detection follows the paper's appendix "Slow slip" exactly:
 
 A cluster ``[k0, k1]`` of smoothed velocities involves the raw velocities ``k0 - w .. k1 + w``
 (``w = 2``, half the averaging width), that is the frames ``k0 - w .. k1 + w + 1``: the slip lies
-between those two frames, which bracket it (``t_start``, ``t_end``) and give ``dR`` as the
-difference of the positions there. Clusters of different interfaces whose brackets overlap form
+between those two frames, which bracket it (``t_start``, ``t_end``). The position of the
+interface before and after the slip is the mean over up to ``position_frames`` frames of stick
+that end at ``t_start`` and start at ``t_end`` (never reaching into the neighbouring slips of
+the same interface): averaging beats the camera's position resolution, and ``dR`` is their
+difference. Clusters of different interfaces whose brackets overlap form
 one *event* with several slipping interfaces: it is flagged ``multi`` and never assigned to one
 interface.
 
@@ -21,8 +24,8 @@ The lever force drop of an event is measured on the force signal outside the bra
 import numpy as np
 import pandas as pd
 
-__all__ = ["VELOCITY_THRESHOLD", "AVERAGE_FRAMES", "MIN_FRAMES", "frame_velocity", "running_average",
-           "clusters", "detect_slips", "force_drop"]
+__all__ = ["VELOCITY_THRESHOLD", "AVERAGE_FRAMES", "MIN_FRAMES", "POSITION_FRAMES", "frame_velocity",
+           "running_average", "clusters", "detect_slips", "force_drop"]
 
 #: Velocity above which a frame belongs to a slip [mm/s] (paper, appendix "Slow slip").
 VELOCITY_THRESHOLD = 0.02
@@ -30,6 +33,8 @@ VELOCITY_THRESHOLD = 0.02
 AVERAGE_FRAMES = 5
 #: Minimum length of a cluster of fast frames [frames].
 MIN_FRAMES = 3
+#: Frames averaged for the position of an interface before and after a slip [frames].
+POSITION_FRAMES = 5
 
 
 def frame_velocity(t_x, R):
@@ -98,7 +103,14 @@ def clusters(mask, min_length=MIN_FRAMES):
     return np.column_stack([first[keep], last[keep]])
 
 
-def detect_slips(t_x, R, *, threshold=VELOCITY_THRESHOLD, width=AVERAGE_FRAMES, min_frames=MIN_FRAMES):
+def _window_means(values, first, last):
+    """Mean of ``values[first[k] : last[k] + 1]`` for every k (inclusive bounds)."""
+    cumulative = np.concatenate([[0.0], np.cumsum(values)])
+    return (cumulative[last + 1] - cumulative[first]) / (last - first + 1)
+
+
+def detect_slips(t_x, R, *, threshold=VELOCITY_THRESHOLD, width=AVERAGE_FRAMES, min_frames=MIN_FRAMES,
+                 position_frames=POSITION_FRAMES):
     """Detect slips on every interface and group simultaneous ones into events.
 
     Parameters
@@ -113,6 +125,8 @@ def detect_slips(t_x, R, *, threshold=VELOCITY_THRESHOLD, width=AVERAGE_FRAMES, 
         Running-average width [frames] (odd).
     min_frames : int
         Minimum number of consecutive fast frames of a slip.
+    position_frames : int
+        Frames averaged for the position before and after a slip.
 
     Returns
     -------
@@ -125,28 +139,38 @@ def detect_slips(t_x, R, *, threshold=VELOCITY_THRESHOLD, width=AVERAGE_FRAMES, 
         - ``i_start``, ``i_end`` (int): frames that bracket the slip;
         - ``t_start``, ``t_end`` [s]: their times;
         - ``t`` [s]: middle of the frame interval with the largest displacement of ``R_a``;
-        - ``dR`` [mm]: ``R_a[i_end] - R_a[i_start]``.
+        - ``R_before``, ``R_after`` [mm]: mean ``R_a`` over the stick frames just before
+          ``i_start`` (inclusive) and just after ``i_end`` (inclusive);
+        - ``dR`` [mm]: ``R_after - R_before``.
     """
     t_x = np.asarray(t_x, dtype=float)
     R = np.asarray(R, dtype=float)
-    velocity = frame_velocity(t_x, R)
-    smooth = running_average(velocity, width)
+    smooth = running_average(frame_velocity(t_x, R), width)
     half = width // 2
-    rows = []
+    columns = ["a", "i_start", "i_end", "t_start", "t_end", "t", "R_before", "R_after"]
+    parts = []
     for column in range(R.shape[1]):
         fast = np.nan_to_num(smooth[:, column], nan=-np.inf) > threshold
-        for k0, k1 in clusters(fast, min_frames):
-            i_start = k0 - half
-            i_end = k1 + half + 1
-            step = i_start + int(np.argmax(np.diff(R[i_start:i_end + 1, column])))
-            rows.append((column + 1, i_start, i_end, t_x[i_start], t_x[i_end],
-                         0.5 * (t_x[step] + t_x[step + 1]), R[i_end, column] - R[i_start, column]))
-    slips = pd.DataFrame(rows, columns=["a", "i_start", "i_end", "t_start", "t_end", "t", "dR"])
+        found = clusters(fast, min_frames)
+        if not len(found):
+            continue
+        i_start, i_end = found[:, 0] - half, found[:, 1] + half + 1
+        position = R[:, column]
+        previous_end = np.concatenate([[0], i_end[:-1]])
+        next_start = np.concatenate([i_start[1:], [R.shape[0] - 1]])
+        step = np.array([i + int(np.argmax(np.diff(position[i:j + 1]))) for i, j in zip(i_start, i_end)])
+        parts.append(pd.DataFrame({
+            "a": column + 1, "i_start": i_start, "i_end": i_end, "t_start": t_x[i_start], "t_end": t_x[i_end],
+            "t": 0.5 * (t_x[step] + t_x[step + 1]),
+            "R_before": _window_means(position, np.maximum(i_start - position_frames + 1, previous_end), i_start),
+            "R_after": _window_means(position, i_end, np.minimum(i_end + position_frames - 1, next_start))}))
+    slips = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=columns)
+    slips["dR"] = (slips["R_after"] - slips["R_before"]).astype(float)
     slips = slips.sort_values(["i_start", "a"], kind="stable").reset_index(drop=True)
     # Overlapping brackets (on different interfaces) make one event.
-    reach = np.maximum.accumulate(slips["i_end"].to_numpy()) if len(slips) else np.zeros(0, int)
+    reach = np.maximum.accumulate(slips["i_end"].to_numpy(dtype=int)) if len(slips) else np.zeros(0, int)
     new_event = np.ones(len(slips), dtype=bool)
-    new_event[1:] = slips["i_start"].to_numpy()[1:] > reach[:-1]
+    new_event[1:] = slips["i_start"].to_numpy(dtype=int)[1:] > reach[:-1]
     slips.insert(0, "event", np.cumsum(new_event) - 1)
     size = slips.groupby("event")["a"].transform("size").to_numpy()
     slips.insert(2, "multi", size > 1)
