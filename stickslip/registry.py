@@ -55,7 +55,7 @@ ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.anal
 
 #: Modules whose import registers the built-in plugins.
 BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis",
-                   "stickslip.figures.mesh")
+                   "stickslip.figures.mesh", "stickslip.solvers.lever")
 
 _RUN_SIGNATURES = {
     "solver": (["params", "output"], ["threads", "inputs"]),

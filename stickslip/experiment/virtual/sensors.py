@@ -1,0 +1,119 @@
+"""Sensors of the virtual experiment: the camera (slab positions) and the force sensor (lever force).
+
+The slips of a :class:`.history.SlipHistory` are turned into continuous signals: interface
+``i`` slips by ``dR`` along the smooth ramp ``dR (1 - cos(pi s)) / 2``, ``s = (t - t_start) /
+slip_duration`` in [0, 1], and creeps linearly at its creep velocity during each creep segment.
+The slab positions follow as ``x = cumsum(R)``, the lever force from the moment balance
+(:meth:`.apparatus.Apparatus.lever_force`). The sensors sample these at fixed rates from
+t = 0 to the end of the run and add independent Gaussian noise: ``position_noise`` [mm] on
+every slab position of every frame, ``force_noise`` [N] on every force sample.
+"""
+
+import numpy as np
+
+from ..timeseries import ExperimentRecord
+
+__all__ = ["sample_times", "relative_positions", "record"]
+
+
+def sample_times(duration, rate):
+    """Sample times ``k / rate`` for k = 0, 1, ... up to ``duration`` [s], float64 [n]."""
+    return np.arange(int(np.floor(duration * rate + 1e-9)) + 1) / rate
+
+
+def _accumulated(times, starts, ends, amounts, ramp):
+    """Sum of amounts reached by ``times`` for non-overlapping episodes sorted by start.
+
+    Parameters
+    ----------
+    times : numpy.ndarray
+        Sample times [s], [n_t].
+    starts, ends, amounts : numpy.ndarray
+        Episodes: start and end [s] and the amount reached at the end, [n_episodes].
+    ramp : callable
+        Fraction reached at relative progress ``s`` in [0, 1] (0 at 0, 1 at 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 [n_t].
+    """
+    if len(starts) == 0:
+        return np.zeros_like(times)
+    done = np.concatenate([[0.0], np.cumsum(amounts)])
+    current = np.searchsorted(starts, times, side="right") - 1
+    inside = current >= 0
+    index = current[inside]
+    length = ends[index] - starts[index]
+    elapsed = times[inside] - starts[index]
+    progress = np.clip(np.divide(elapsed, length, out=np.ones_like(elapsed), where=length > 0), 0.0, 1.0)
+    total = np.zeros_like(times)
+    total[inside] = done[index] + amounts[index] * ramp(progress)
+    return total
+
+
+def _cosine_ramp(s):
+    return 0.5 * (1.0 - np.cos(np.pi * s))
+
+
+def _linear_ramp(s):
+    return s
+
+
+def relative_positions(history, times):
+    """Noise-free slip R_i(t) of every interface at ``times``.
+
+    Parameters
+    ----------
+    history : SlipHistory
+    times : numpy.ndarray
+        Sample times [s], [n_t] (any order).
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 [n_t, n_slabs] [mm].
+    """
+    R = np.tile(history.R0, (times.size, 1))
+    for column in range(history.R0.size):
+        slips = history.slips[history.slips["a"] == column + 1]
+        R[:, column] += _accumulated(times, slips["t_start"].to_numpy(float), slips["t_end"].to_numpy(float),
+                                     slips["dR"].to_numpy(float), _cosine_ramp)
+        creep = history.creep[history.creep["a"] == column + 1].sort_values("t_on")
+        on, off = creep["t_on"].to_numpy(float), creep["t_off"].to_numpy(float)
+        R[:, column] += _accumulated(times, on, off, creep["velocity"].to_numpy(float) * (off - on), _linear_ramp)
+    return R
+
+
+def record(apparatus, history, *, n, protocol, a, force_rate, frame_rate, force_noise, position_noise, rng):
+    """Sample the sensors and return the experiment record.
+
+    Parameters
+    ----------
+    apparatus : Apparatus
+    history : SlipHistory
+    n, a : int
+        Driven slabs and the slab driven alone (0 for "stack"), as recorded.
+    protocol : {"stack", "individual"}
+    force_rate, frame_rate : float
+        Sampling rates of the force sensor and the camera [Hz].
+    force_noise : float
+        Standard deviation of the force noise [N].
+    position_noise : float
+        Standard deviation of the position noise [mm].
+    rng : numpy.random.Generator
+        Source of the sensor noise (positions first, then force).
+
+    Returns
+    -------
+    ExperimentRecord
+    """
+    t_x = sample_times(history.duration, frame_rate)
+    t_F = sample_times(history.duration, force_rate)
+    x = apparatus.positions(relative_positions(history, t_x))
+    F = apparatus.lever_force(apparatus.spring_forces(t_F, apparatus.positions(relative_positions(history, t_F))))
+    x = x + position_noise * rng.standard_normal(x.shape)
+    F = F + force_noise * rng.standard_normal(F.shape)
+    return ExperimentRecord(t_F=t_F, F=F, t_x=t_x, x=x, n=n, n_slabs=apparatus.n_slabs, protocol=protocol, a=a,
+                            normal_force=apparatus.normal_force, k_spring=apparatus.k_spring, h=apparatus.h,
+                            H=apparatus.H, V=apparatus.lever_speed)

@@ -1,0 +1,1 @@
+"""Solver plugins: turn parameters into simulation output files (``fem``, ``lever``)."""

@@ -1,0 +1,184 @@
+"""Solver ``lever``: a virtual experiment of the paper's apparatus, written as a lab recording.
+
+Rigid slabs on a fixed base, springs to a lever driven at constant speed, interfaces with
+logarithmic aging, threshold disorder, optional creep and triggered simultaneous slips
+(model and equations: docs/experiment-model.md; code: :mod:`stickslip.experiment.virtual`).
+The output is the experimental time-series file (:mod:`stickslip.experiment.timeseries`)
+with the parameters (JSON) and seed as attributes and two ground-truth tables:
+
+``truth``: one row per interface per slip, columns ``event``, ``t_start``, ``t_end`` [s],
+``a``, ``dR`` [mm], ``dF`` [N], ``dmu``, ``mu_before``, ``mu_after``, ``T`` [s], ``age`` [s],
+``excess``, ``multi``, ``triggered``, ``creep_before`` [mm] (see
+:func:`stickslip.experiment.virtual.integrate`).
+
+``interfaces``: one row per interface ``a`` = 1..n_slabs: ``slippable`` (can slip in this
+protocol), ``mu_d``, ``B``, ``creep_velocity`` [mm/s] (effective, after the scaling with n),
+``n_slips``, ``slip_total`` [mm] (sum of dR), ``creep_total`` [mm] (slow slip over the run),
+``R_total`` [mm] (R_a at the end minus at the start, noise-free; equals slip_total +
+creep_total except for a slip still running at the end).
+"""
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+
+from .. import registry
+from ..experiment.timeseries import PROTOCOLS, write_timeseries
+from ..experiment.virtual import Apparatus, FrictionLaw, integrate, record, relative_positions
+from ..params import ParameterError, param, params_to_dict
+
+__all__ = ["LeverParams", "run", "simulate"]
+
+VERSION = "1"
+
+#: Per-interface parameters: one value for every interface, or one per interface.
+PER_INTERFACE = ("mu_d", "B", "creep_velocity")
+
+
+@dataclasses.dataclass(frozen=True)
+class LeverParams:
+    """Parameters of one virtual run (defaults: the paper's apparatus and the default study)."""
+
+    n: int = param(1, "driven slabs (springs attached); 1 for the individual protocol", minimum=1)
+    protocol: str = param("stack", "stack: slabs 1..n driven; individual: slab a alone, slabs below clamped",
+                          choices=PROTOCOLS)
+    a: int = param(0, "slab driven alone (individual protocol); 0 for stack", minimum=0)
+    n_slabs: int = param(5, "slabs in the stack", minimum=1)
+    seed: int = param(0, "seed of every random stream (disorder, sensor noise)", minimum=0)
+    duration: float = param(6000.0, "length of the run (the paper: 0.6 rad at 1e-4 /s)", unit="s",
+                            exclusive_minimum=0)
+    gamma_start: float = param(-0.30, "lever rotation gamma = U/H at t = 0", unit="rad")
+    normal_force: float = param(49.0, "normal force N (5 kg dead weight)", unit="N", exclusive_minimum=0)
+    k_spring: float = param(55.0, "spring stiffness K", unit="N/mm", exclusive_minimum=0)
+    h: float = param(10.0, "slab thickness h", unit="mm", exclusive_minimum=0)
+    H: float = param(100.0, "lever height H", unit="mm", exclusive_minimum=0)
+    V: float = param(0.01, "lever-top speed V (individual protocol: the lever moves at V/a)", unit="mm/s",
+                     exclusive_minimum=0)
+    mu_d: tuple[float, ...] = param((0.35,), "dynamic friction level per interface (one value: all)", minimum=0)
+    B: tuple[float, ...] = param((0.045, 0.032, 0.055, 0.038, 0.050),
+                                 "aging rate per interface (one value: all)", exclusive_minimum=0)
+    T0: float = param(1.0, "aging time scale T0", unit="s", exclusive_minimum=0)
+    threshold_noise: float = param(0.015, "scale of the half-normal threshold excess (annealed disorder)",
+                                   minimum=0)
+    creep_velocity: tuple[float, ...] = param(
+        (0.002, 0.001, 0.0, 0.0, 0.0),
+        "creep velocity per interface with all slabs driven; scaled by (n-1)/(n_slabs-1) (one value: all)",
+        unit="mm/s", minimum=0)
+    creep_onset: float = param(0.8, "creep starts at this fraction of the strength above mu_d",
+                               exclusive_minimum=0, maximum=1)
+    trigger_margin: float = param(0.0, "interfaces this close to their strength slip with the one that slips",
+                                  minimum=0)
+    slip_duration: float = param(0.2, "duration of a slip", unit="s", exclusive_minimum=0)
+    force_rate: float = param(50.0, "force sampling rate", unit="Hz", exclusive_minimum=0)
+    force_noise: float = param(0.01, "standard deviation of the force noise", unit="N", minimum=0)
+    frame_rate: float = param(5.0, "camera frame rate", unit="Hz", exclusive_minimum=0)
+    position_noise: float = param(0.002, "standard deviation of the position noise of every slab", unit="mm",
+                                  minimum=0)
+
+    def check(self):
+        """Check the conditions that involve several fields."""
+        if self.protocol == "stack":
+            if self.n > self.n_slabs:
+                raise ParameterError(f"parameter 'n': expected a value <= n_slabs={self.n_slabs}, got {self.n}")
+            if self.a != 0:
+                raise ParameterError(f"parameter 'a': must be 0 for the stack protocol, got {self.a}")
+        else:
+            if not 1 <= self.a <= self.n_slabs:
+                raise ParameterError(f"parameter 'a': expected 1..n_slabs={self.n_slabs} for the individual "
+                                     f"protocol, got {self.a}")
+            if self.n != 1:
+                raise ParameterError(f"parameter 'n': must be 1 for the individual protocol, got {self.n}")
+        for name in PER_INTERFACE:
+            if len(getattr(self, name)) not in (1, self.n_slabs):
+                raise ParameterError(f"parameter '{name}': expected 1 or n_slabs={self.n_slabs} values, "
+                                     f"got {len(getattr(self, name))}")
+        fastest = apparatus(self).loading_rates().max() * self.slip_duration
+        heals = np.min(per_interface(self, "B")) * np.log1p(self.slip_duration / self.T0)
+        if heals <= fastest:
+            raise ParameterError(
+                f"parameter 'B': the weakest aging, B ln(1 + slip_duration/T0) = {heals:.3g}, must exceed the "
+                f"loading during a slip, {fastest:.3g}, or an interface slips again before it heals")
+
+
+def per_interface(params, name):
+    """A per-interface parameter as float64 [n_slabs] (a single value is repeated)."""
+    values = np.asarray(getattr(params, name), dtype=float)
+    return np.broadcast_to(values, (params.n_slabs,)).copy()
+
+
+def apparatus(params):
+    """The :class:`~stickslip.experiment.virtual.Apparatus` of the parameters."""
+    return Apparatus.from_protocol(params.protocol, n=params.n, a=params.a, n_slabs=params.n_slabs,
+                                   k_spring=params.k_spring, normal_force=params.normal_force, h=params.h,
+                                   H=params.H, V=params.V, gamma_start=params.gamma_start)
+
+
+def friction_law(params):
+    """The :class:`~stickslip.experiment.virtual.FrictionLaw` of the parameters.
+
+    The creep velocities are scaled by ``(n_driven - 1) / (n_slabs - 1)``: creep, read as
+    activated by the mechanical noise of the other driven interfaces (paper, "Creep effective
+    temperature"), vanishes for a single driven slab and reaches ``creep_velocity`` for a full stack.
+    """
+    n_driven = params.n if params.protocol == "stack" else 1
+    scale = (n_driven - 1) / max(params.n_slabs - 1, 1)
+    return FrictionLaw(mu_d=per_interface(params, "mu_d"), B=per_interface(params, "B"), T0=params.T0,
+                       threshold_noise=params.threshold_noise,
+                       creep_velocity=scale * per_interface(params, "creep_velocity"),
+                       creep_onset=params.creep_onset, trigger_margin=params.trigger_margin)
+
+
+def _interfaces_table(lever, law, history):
+    slippable = np.zeros(lever.n_slabs, bool)
+    slippable[np.asarray(lever.slippable) - 1] = True
+    index = np.arange(1, lever.n_slabs + 1)
+    slips = history.slips.groupby("a")["dR"].agg(["size", "sum"]).reindex(index, fill_value=0)
+    creep = history.creep.assign(total=history.creep["velocity"] * (history.creep["t_off"] - history.creep["t_on"]))
+    creep_total = creep.groupby("a")["total"].sum().reindex(index, fill_value=0.0)
+    ends = relative_positions(history, np.array([0.0, history.duration]))
+    return pd.DataFrame({"a": index, "slippable": slippable, "mu_d": law.mu_d, "B": law.B,
+                         "creep_velocity": law.creep_velocity, "n_slips": slips["size"].to_numpy(np.int64),
+                         "slip_total": slips["sum"].to_numpy(float), "creep_total": creep_total.to_numpy(float),
+                         "R_total": ends[1] - ends[0]})
+
+
+def simulate(params):
+    """Run the virtual experiment.
+
+    Parameters
+    ----------
+    params : LeverParams
+
+    Returns
+    -------
+    record : ExperimentRecord
+        The sensor signals.
+    truth : pandas.DataFrame
+        One row per interface per slip.
+    interfaces : pandas.DataFrame
+        One row per interface.
+
+    Notes
+    -----
+    Two independent random streams derive from ``seed``: the threshold disorder and the
+    sensor noise, so changing a noise level leaves the slips unchanged.
+    """
+    disorder_seed, sensor_seed = np.random.SeedSequence(params.seed).spawn(2)
+    lever, law = apparatus(params), friction_law(params)
+    history = integrate(lever, law, params.duration, params.slip_duration,
+                        np.random.Generator(np.random.PCG64(disorder_seed)))
+    signals = record(lever, history, n=params.n, protocol=params.protocol, a=params.a,
+                     force_rate=params.force_rate, frame_rate=params.frame_rate, force_noise=params.force_noise,
+                     position_noise=params.position_noise, rng=np.random.Generator(np.random.PCG64(sensor_seed)))
+    return signals, history.slips, _interfaces_table(lever, law, history)
+
+
+@registry.register("solver", "lever", VERSION, LeverParams,
+                   summary="virtual lever experiment (aging, disorder, creep) written as a lab time series")
+def run(params, output, *, threads, inputs):
+    """Run one virtual experiment and write its time-series file with the ground truth."""
+    signals, truth, interfaces = simulate(params)
+    write_timeseries(output, signals, attrs={"params": params_to_dict(params), "seed": params.seed,
+                                             "solver": "lever", "solver_version": VERSION},
+                     tables={"truth": truth, "interfaces": interfaces})
