@@ -55,7 +55,9 @@ ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.anal
 
 #: Modules whose import registers the built-in plugins.
 BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis",
-                   "stickslip.figures.mesh", "stickslip.solvers.lever")
+                   "stickslip.figures.mesh", "stickslip.solvers.lever", "stickslip.figures.fig2",
+                   "stickslip.figures.figs_dgamma", "stickslip.figures.figs_sequences",
+                   "stickslip.figures.figs_event_maps", "stickslip.figures.figs_tau")
 
 _RUN_SIGNATURES = {
     "solver": (["params", "output"], ["threads", "inputs"]),
@@ -63,7 +65,7 @@ _RUN_SIGNATURES = {
     "figure": (["params", "inputs", "output"], []),
 }
 
-_NAME = re.compile(r"^[a-z0-9][a-z0-9_-]*$")
+_NAME = re.compile(r"^[a-z0-9][A-Za-z0-9_-]*$")
 
 _plugins = {kind: {} for kind in KINDS}
 _loaded = False
@@ -82,7 +84,8 @@ class Plugin:
     kind : str
         One of :data:`KINDS`.
     name : str
-        Unique within its kind; lowercase letters, digits, ``-`` and ``_``.
+        Unique within its kind; starts with a lowercase letter or digit, then
+        letters, digits, ``-`` and ``_`` (e.g. ``fem``, ``figS-mesh``).
     version : str
         Version of the plugin's algorithm; part of every run id it produces.
     params : type

@@ -1,4 +1,4 @@
-"""Figure plugin 'figs-mesh': picks the requested mesh among its inputs, writes PDF and PNG."""
+"""Figure plugin 'figS-mesh': picks the requested mesh among its inputs, writes PDF and PNG."""
 
 import pytest
 
@@ -29,9 +29,9 @@ def test_selects_the_mesh_by_plates_and_N(meshes):
 
 
 def test_plugin_writes_pdf_and_png(meshes, tmp_path):
-    plugin = registry.get("figure", "figs-mesh")
+    plugin = registry.get("figure", "figS-mesh")
     assert plugin.inputs == ("mesh",)
     params = parse_params(plugin.params, {"plates": 3, "zoom_width": 20})
-    output = tmp_path / "figs-mesh.pdf"
+    output = tmp_path / "figS-mesh.pdf"
     plugin.run(params, {"mesh": list(meshes.values())}, output)
     assert output.stat().st_size > 0 and output.with_suffix(".png").stat().st_size > 0

@@ -70,7 +70,7 @@ def select_mesh(paths, params):
     if not candidates:
         have = ", ".join(f"plates={p} N={n}" for p, n, _, _ in sorted(available)) or "none"
         wanted = f"plates={params.plates}" + (f" N={params.N}" if params.N else "")
-        raise FileFormatError(f"figure 'figs-mesh': no mesh with {wanted} among its inputs (available: {have}); "
+        raise FileFormatError(f"figure 'figS-mesh': no mesh with {wanted} among its inputs (available: {have}); "
                               f"add such a mesh to the study or set the figure's 'plates'/'N'")
     return candidates[-1][3]
 
@@ -139,7 +139,7 @@ def _draw_zoom(zoom, full, mesh, width):
     full.add_patch(plt.Rectangle((0.0, bottom), width, top - bottom, fill=False, edgecolor="r", lw=0.8))
 
 
-@register("figure", "figs-mesh", "1", MeshFigureParams, inputs=("mesh",))
+@register("figure", "figS-mesh", "1", MeshFigureParams, inputs=("mesh",))
 def run(params, inputs, output):
     """SI figure: the finite-element mesh of the numerical model, coloured per layer."""
     mesh = read_mesh(select_mesh(inputs.get("mesh", []), params))

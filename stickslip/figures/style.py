@@ -6,11 +6,7 @@ Every figure module uses :func:`interface_color` for anything tied to interface
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+import matplotlib.pyplot as plt
 
 __all__ = ["INTERFACE_COLORS", "interface_color", "n_color", "save_figure", "plt"]
 
