@@ -32,7 +32,7 @@ from . import extraction
 from .plugin import event_attrs
 
 __all__ = ["FrontParams", "VERSION", "slipping_interfaces", "front_fit", "analyse_event", "multi_slip_increments",
-           "interface_spacing", "front_tables", "run"]
+           "interface_spacing", "front_tables", "write_front_file", "run"]
 
 VERSION = "1"
 
@@ -247,6 +247,24 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
     return failure_table[list(FAILURE_DTYPES)].astype(FAILURE_DTYPES), front_table.astype(FRONT_DTYPES)
 
 
+def write_front_file(failures, fronts, attrs, output):
+    """Write the tables ``failures`` and ``fronts`` and the attributes to ``output`` (atomically).
+
+    Parameters
+    ----------
+    failures, fronts : pandas.DataFrame
+        Output of :func:`front_tables`.
+    attrs : Mapping[str, object]
+        Run attributes as :func:`stickslip.events.plugin.event_attrs` gives them, plus
+        ``interface_spacing`` [FE length].
+    output : str or pathlib.Path
+    """
+    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
+        h5io.write_attrs(file, {**attrs, "analysis": "front-dynamics", "analysis_version": VERSION})
+        h5io.write_table(file, "failures", failures)
+        h5io.write_table(file, "fronts", fronts)
+
+
 @register("analysis", "front-dynamics", VERSION, FrontParams, inputs=("fem",))
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
@@ -262,9 +280,5 @@ def run(params, input, output):
     failures, fronts = front_tables(classified, lambda increment: rerun_with_failures(input, increment), N=N,
                                     h=float(run_attrs["h"]), c_s=float(run_attrs["c_s"]), spacing=spacing,
                                     params=params)
-    attrs = {**event_attrs(run_attrs, classified, source=str(input)), "interface_spacing": spacing,
-             "analysis": "front-dynamics", "analysis_version": VERSION}
-    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
-        h5io.write_attrs(file, attrs)
-        h5io.write_table(file, "failures", failures)
-        h5io.write_table(file, "fronts", fronts)
+    attrs = {**event_attrs(run_attrs, classified, source=str(input)), "interface_spacing": spacing}
+    write_front_file(failures, fronts, attrs, output)
