@@ -80,7 +80,8 @@ def first_crossing(mu, rate, level, slope, T, T0):
     """Smallest ``tau >= 0`` at which ``mu + rate tau`` reaches ``level + slope ln(1 + (T + tau) / T0)``.
 
     The gap ``g(tau) = mu + rate tau - level - slope ln(1 + (T + tau) / T0)`` is convex; if
-    ``g(0) < 0`` its first root lies beyond its minimum, where Newton's method started from a
+    ``g(0) < 0``, or ``g(0) = 0`` and ``g`` decreases (the level moves away, as right after
+    a slip without disorder), the crossing lies beyond the minimum of ``g``, where Newton's method started from a
     point with ``g >= 0`` decreases monotonically onto the root (so the returned time never
     falls short of it by more than rounding).
 
@@ -107,7 +108,8 @@ def first_crossing(mu, rate, level, slope, T, T0):
     def gap(tau):
         return mu + rate * tau - level - slope * math.log1p((T + tau) / T0)
 
-    if gap(0.0) >= 0.0:
+    now = gap(0.0)
+    if now > 0.0 or (now == 0.0 and rate >= slope / (T0 + T)):
         return 0.0
     if rate <= 0.0:
         return math.inf

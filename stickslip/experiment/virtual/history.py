@@ -11,8 +11,8 @@ each found in closed form by :func:`.friction.first_crossing`. A slip of interfa
 starts at ``t_start`` and, together with every other interface within ``trigger_margin`` of
 its strength (a simultaneous, triggered slip), drops the friction coefficients of the slipping
 interfaces to their dynamic levels: the slips ``dR`` [mm] solve ``C_SS dR = mu_S - mu_d,S``
-(``C`` the coupling matrix; an interface whose solution is not positive is dropped from the
-group, as it is unloaded below its dynamic level by the others). Every slab above a slipping
+(``C`` the coupling matrix; a triggered interface whose solution is not positive is dropped
+from the group, as the others unload it below its dynamic level). Every slab above a slipping
 interface moves with it (rigid slabs). The slip lasts ``slip_duration``; no other event starts
 during it (the drive keeps loading); it stops every creeping interface. Then the slipped
 interfaces draw new threshold excesses and their aging clocks restart from ``t_start``.
@@ -75,7 +75,9 @@ def _slip_group(C, mu, target_mu, group):
     Returns
     -------
     group : list[int]
-        The interfaces that slip (those whose solved slip is positive).
+        The interfaces that slip: a triggered interface whose solved slip is not positive is
+        unloaded below its dynamic level by the others and drops out; if the first one's is
+        not positive, it slips alone.
     dR : numpy.ndarray
         Their slips [mm].
     """
@@ -84,7 +86,10 @@ def _slip_group(C, mu, target_mu, group):
         dR = np.linalg.solve(C[np.ix_(group, group)], mu[group] - target_mu[group])
         if np.all(dR > 0.0) or len(group) == 1:
             return group, dR
-        group = [i for i, d in zip(group, dR) if d > 0.0] or group[:1]
+        if dR[0] <= 0.0:
+            group = group[:1]
+        else:
+            group = [i for i, d in zip(group, dR) if d > 0.0]
 
 
 def integrate(apparatus, law, duration, slip_duration, rng):
@@ -121,8 +126,10 @@ def integrate(apparatus, law, duration, slip_duration, rng):
     slippable = [i - 1 for i in apparatus.slippable]
     C = apparatus.coupling()
     drive_rates = apparatus.loading_rates()
+    unloaded = apparatus.mu(0.0, np.zeros(n_slabs))     # mu at t = 0 with every R = 0
     force_per_slip = apparatus.k_spring * np.cumsum(apparatus.heights[::-1])[::-1] / apparatus.H
-    can_creep = law.creep_velocity > 0.0
+    can_creep = (law.creep_velocity > 0.0).tolist()
+    mu_d, B = law.mu_d.tolist(), law.B.tolist()
 
     R0 = apparatus.relaxed_slips(law.mu_d)
     R = R0.copy()
@@ -144,14 +151,15 @@ def integrate(apparatus, law, duration, slip_duration, rng):
 
     while t < duration:
         velocity = np.where(creeping, law.creep_velocity, 0.0)
-        rates = drive_rates - C @ velocity
-        mu = apparatus.mu(t, R)
+        rates = (drive_rates - C @ velocity).tolist()
+        mu = (unloaded + drive_rates * t - C @ R).tolist()
         tau, kind, which = duration - t, "end", -1
         for i in slippable:
-            T = t - onset[i]
-            candidates = [("slip", law.mu_d[i] + excess[i], law.B[i])]
+            T = t - float(onset[i])
+            level, slope = mu_d[i] + float(excess[i]), B[i]
+            candidates = [("slip", level, slope)]
             if can_creep[i] and not creeping[i]:
-                candidates.append(("creep", law.mu_d[i] + law.creep_onset * excess[i], law.creep_onset * law.B[i]))
+                candidates.append(("creep", mu_d[i] + law.creep_onset * float(excess[i]), law.creep_onset * slope))
             for name, level, slope in candidates:
                 reach = first_crossing(mu[i], rates[i], level, slope, T, law.T0)
                 if reach < tau:
@@ -166,7 +174,7 @@ def integrate(apparatus, law, duration, slip_duration, rng):
             creep_start[which] = t
             continue
         stop_creep(t)
-        mu = apparatus.mu(t, R)
+        mu = unloaded + drive_rates * t - C @ R
         gap = law.strength(t - onset, excess) - mu
         group = [which] + [i for i in slippable if i != which and gap[i] < law.trigger_margin]
         group, dR = _slip_group(C, mu, law.mu_d, group)

@@ -22,33 +22,30 @@ def sample_times(duration, rate):
 
 
 def _accumulated(times, starts, ends, amounts, ramp):
-    """Sum of amounts reached by ``times`` for non-overlapping episodes sorted by start.
+    """Sum of amounts reached at ``times`` by episodes that do not overlap.
 
     Parameters
     ----------
     times : numpy.ndarray
-        Sample times [s], [n_t].
+        Sample times [s], increasing, [n_t].
     starts, ends, amounts : numpy.ndarray
         Episodes: start and end [s] and the amount reached at the end, [n_episodes].
     ramp : callable
-        Fraction reached at relative progress ``s`` in [0, 1] (0 at 0, 1 at 1).
+        Fraction reached at relative progress ``s`` in (0, 1) (0 at 0, 1 at 1).
 
     Returns
     -------
     numpy.ndarray
         float64 [n_t].
     """
-    if len(starts) == 0:
-        return np.zeros_like(times)
-    done = np.concatenate([[0.0], np.cumsum(amounts)])
-    current = np.searchsorted(starts, times, side="right") - 1
-    inside = current >= 0
-    index = current[inside]
-    length = ends[index] - starts[index]
-    elapsed = times[inside] - starts[index]
-    progress = np.clip(np.divide(elapsed, length, out=np.ones_like(elapsed), where=length > 0), 0.0, 1.0)
-    total = np.zeros_like(times)
-    total[inside] = done[index] + amounts[index] * ramp(progress)
+    first = np.searchsorted(times, starts, side="right")   # first sample after the start
+    last = np.searchsorted(times, ends, side="left")       # first sample at or after the end
+    jumps = np.zeros(times.size + 1)
+    np.add.at(jumps, last, amounts)
+    total = np.cumsum(jumps[:-1])
+    for begin, stop, start, end, amount in zip(first, last, starts, ends, amounts):
+        if begin < stop:
+            total[begin:stop] += amount * ramp((times[begin:stop] - start) / (end - start))
     return total
 
 
@@ -67,7 +64,7 @@ def relative_positions(history, times):
     ----------
     history : SlipHistory
     times : numpy.ndarray
-        Sample times [s], [n_t] (any order).
+        Sample times [s], increasing, [n_t].
 
     Returns
     -------
