@@ -6,7 +6,8 @@ run). Output: one HDF5 file with two tables (:func:`stickslip.h5io.write_table`)
 attributes copied to the root:
 
 ``slips``: one row per slip of one interface, sorted by time (see :func:`analyse_record`).
-``interfaces``: one row per interface ``a``: ``R_tot`` [mm] (total sliding over the analysed
+``interfaces``: one row per interface ``a``: ``driven`` (it can slip: ``a <= n`` in the stack,
+``a`` the driven slab in the individual protocol), ``R_tot`` [mm] (total sliding over the analysed
 record), ``dR_sum`` [mm] (sum of its detected slips), ``R_slow`` (``1 - dR_sum / R_tot``),
 ``n_slips``, ``n_multi``.
 
@@ -95,7 +96,7 @@ def analyse_record(record, params=ExperimentEventsParams()):
         (``dmu / ln(T / T0)``), ``drift`` [mm] (``R_a`` just before the slip minus ``R_a`` just
         after the previous slip of ``a``, both averaged over ``position_frames`` frames), ``slow_slip_before`` (``drift >= slow_slip_drift``).
     interfaces : pandas.DataFrame
-        Columns ``a``, ``R_tot``, ``dR_sum`` [mm], ``R_slow`` [-], ``n_slips``, ``n_multi``.
+        Columns ``a``, ``driven``, ``R_tot``, ``dR_sum`` [mm], ``R_slow`` [-], ``n_slips``, ``n_multi``.
     """
     R = record.R
     slips = detection.detect_slips(record.t_x, R, threshold=params.threshold, width=params.average_frames,
@@ -126,7 +127,9 @@ def analyse_record(record, params=ExperimentEventsParams()):
     slips = slips[slips["i_start"].to_numpy() >= first_frame].sort_values(["t", "a"], kind="stable")
     slips = slips[SLIP_COLUMNS].reset_index(drop=True)
 
-    interfaces = pd.DataFrame({"a": np.arange(1, R.shape[1] + 1)})
+    index = np.arange(1, R.shape[1] + 1)
+    driven = index <= record.n if record.protocol == "stack" else index == record.a
+    interfaces = pd.DataFrame({"a": index, "driven": driven})
     interfaces["R_tot"] = R[-1] - R[first_frame]
     grouped = slips.groupby("a")
     interfaces["dR_sum"] = interfaces["a"].map(grouped["dR"].sum()).fillna(0.0)
