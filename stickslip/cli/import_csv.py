@@ -1,0 +1,44 @@
+"""``stickslip import-csv``: convert a lab export (force CSV + positions CSV) into a time-series file."""
+
+from pathlib import Path
+
+from ..experiment.csv_import import UNITS, import_csv
+from ..experiment.timeseries import PROTOCOLS
+
+
+def add_parser(subparsers):
+    """Add the ``import-csv`` sub-command."""
+    parser = subparsers.add_parser(
+        "import-csv", help="convert lab CSV exports into an experimental time-series file",
+        description="Read a force CSV (columns 't [s]', 'F [N]') and a positions CSV (columns 't [s]', "
+                    "'x1 [mm]' ... 'x<n_slabs> [mm]', x1 the lowest slab) and write the HDF5 time-series "
+                    "file that `stickslip analyze-experiment` reads. Lines starting with '#' are comments.")
+    parser.add_argument("--force", required=True, type=Path, metavar="FORCE.csv", help="force CSV file")
+    parser.add_argument("--positions", required=True, type=Path, metavar="POSITIONS.csv",
+                        help="slab positions CSV file")
+    parser.add_argument("-o", "--output", required=True, type=Path, help="output file (HDF5)")
+    parser.add_argument("--n", required=True, type=int, help="driven slabs (1 for the individual protocol)")
+    parser.add_argument("--n-slabs", type=int, default=5, help="slabs in the stack (default 5)")
+    parser.add_argument("--protocol", choices=PROTOCOLS, default="stack", help="driving protocol (default stack)")
+    parser.add_argument("--a", type=int, default=0, help="slab driven alone (individual protocol; default 0)")
+    parser.add_argument("--normal-force", type=float, default=49.0, help="normal force N [N] (default 49)")
+    parser.add_argument("--k-spring", type=float, default=55.0, help="spring stiffness K [N/mm] (default 55)")
+    parser.add_argument("--h", type=float, default=10.0, help="slab thickness [mm] (default 10)")
+    parser.add_argument("--H", type=float, default=100.0, help="lever height [mm] (default 100)")
+    parser.add_argument("--V", type=float, default=0.01,
+                        help="lever-top speed imposed during the run [mm/s] (default 0.01)")
+    parser.add_argument("--time-unit", choices=list(UNITS["time"]), help="unit of time columns without one")
+    parser.add_argument("--force-unit", choices=list(UNITS["force"]), help="unit of force columns without one")
+    parser.add_argument("--position-unit", choices=list(UNITS["length"]),
+                        help="unit of position columns without one")
+    parser.set_defaults(func=run)
+
+
+def run(args):
+    """Import the two CSV files."""
+    record = import_csv(args.force, args.positions, args.output, n=args.n, n_slabs=args.n_slabs,
+                        protocol=args.protocol, a=args.a, normal_force=args.normal_force, k_spring=args.k_spring,
+                        h=args.h, H=args.H, V=args.V, time_unit=args.time_unit, force_unit=args.force_unit,
+                        position_unit=args.position_unit)
+    print(f"{args.output}: {record.t_F.size} force samples, {record.t_x.size} frames of {record.n_slabs} slabs")
+    return 0

@@ -1,0 +1,198 @@
+"""Import lab exports (two CSV files) into the experimental time-series format.
+
+CSV layout (comma-separated, one header line, lines starting with ``#`` are comments)::
+
+    # force.csv                      # positions.csv
+    t [s],F [N]                      t [s],x1 [mm],x2 [mm],x3 [mm],x4 [mm],x5 [mm]
+    0.00,2.803                       0.0,-3.21,-6.42,-9.63,-9.63,-9.63
+    0.02,2.805                       0.2,-3.21,-6.42,-9.63,-9.63,-9.63
+
+- force file: exactly the columns ``t`` and ``F``;
+- positions file: exactly ``t``, ``x1`` ... ``x<n_slabs>`` (``x1`` the lowest slab), absolute
+  horizontal positions of the slabs;
+- every header names its unit in brackets. Accepted units, converted to the format's units:
+  time ``s``, ``ms``; force ``N``, ``mN``, ``kN``; length ``mm``, ``um`` (or ``µm``), ``m``.
+  A file whose headers carry no unit can be read by declaring the units
+  (``time_unit``, ``force_unit``, ``position_unit``); a declared unit that contradicts a
+  header is an error.
+
+Errors (:class:`stickslip.h5io.FileFormatError`) name the file, the column and, for bad
+values, the line: missing or unexpected columns, missing or unknown units, non-numeric or
+NaN/inf values, times that do not strictly increase, fewer than two rows.
+"""
+
+import hashlib
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..h5io import FileFormatError
+from .timeseries import ExperimentRecord, write_timeseries
+
+__all__ = ["UNITS", "import_csv", "read_csv_columns"]
+
+#: Accepted units per quantity, with the factor to the format's unit (s, N, mm).
+UNITS = {
+    "time": {"s": 1.0, "ms": 1e-3},
+    "force": {"N": 1.0, "mN": 1e-3, "kN": 1e3},
+    "length": {"mm": 1.0, "um": 1e-3, "µm": 1e-3, "m": 1e3},
+}
+
+_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
+
+
+def _parse_header(path, header):
+    """Map each column name to its unit ('' when the header has none)."""
+    columns = {}
+    for position, text in enumerate(header, start=1):
+        match = _HEADER.match(str(text))
+        if match is None:
+            raise FileFormatError(f"{path}: header column {position} {text!r} is not of the form 'name [unit]'")
+        name, unit = match.group(1), match.group(2) or ""
+        if name in columns:
+            raise FileFormatError(f"{path}: column '{name}' appears twice in the header")
+        columns[name] = unit
+    return columns
+
+
+def _factor(path, column, unit, quantity, declared):
+    units = UNITS[quantity]
+    accepted = ", ".join(units)
+    if declared is not None and declared not in units:
+        raise FileFormatError(f"{path}: declared {quantity} unit {declared!r} is not known; expected one of {accepted}")
+    if unit and declared is not None and unit != declared:
+        raise FileFormatError(f"{path}: column '{column}' is in [{unit}] but the declared {quantity} unit is "
+                              f"{declared!r}")
+    unit = unit or declared
+    if not unit:
+        raise FileFormatError(f"{path}: column '{column}' has no unit; write it in the header as "
+                              f"'{column} [{next(iter(units))}]' or declare the {quantity} unit")
+    if unit not in units:
+        raise FileFormatError(f"{path}: column '{column}' has unit [{unit}], which is not a {quantity} unit; "
+                              f"expected one of {accepted}")
+    return units[unit]
+
+
+def read_csv_columns(path, quantities, units):
+    """Read a CSV file with exactly the given columns, converted to the format's units.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    quantities : Mapping[str, str]
+        Column name to quantity (``"time"``, ``"force"`` or ``"length"``), in the expected order;
+        the first column is the time axis, which must increase strictly.
+    units : Mapping[str, str or None]
+        Declared unit per quantity, for headers without one (None: the header must name it).
+
+    Returns
+    -------
+    dict[str, numpy.ndarray]
+        float64 [n_rows] per column, in s, N or mm.
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        See the module docstring.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileFormatError(f"{path}: no such file")
+    try:
+        table = pd.read_csv(path, comment="#", header=None, dtype=str, skipinitialspace=True,
+                            keep_default_na=False)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as error:
+        raise FileFormatError(f"{path}: not a readable CSV file ({error})") from error
+    header = _parse_header(path, table.iloc[0])
+    table = table.iloc[1:].reset_index(drop=True)
+    missing = [name for name in quantities if name not in header]
+    if missing:
+        raise FileFormatError(f"{path}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}; "
+                              f"expected exactly {', '.join(quantities)}")
+    unexpected = [name for name in header if name not in quantities]
+    if unexpected:
+        raise FileFormatError(f"{path}: unexpected column{'s' if len(unexpected) > 1 else ''} "
+                              f"{', '.join(unexpected)}; expected exactly {', '.join(quantities)}")
+    if len(table) < 2:
+        raise FileFormatError(f"{path}: expected at least 2 data rows, got {len(table)}")
+    lines = _data_line_numbers(path, len(table))
+    values = {}
+    text = {name: table[position].str.strip() for position, name in enumerate(header)}
+    for name, unit in header.items():
+        factor = _factor(path, name, unit, quantities[name], units.get(quantities[name]))
+        column = pd.to_numeric(text[name], errors="coerce").to_numpy(dtype=float)
+        bad = ~np.isfinite(column)
+        if np.any(bad):
+            row = int(np.argmax(bad))
+            raise FileFormatError(f"{path}: line {lines[row]}, column '{name}': expected a finite number, "
+                                  f"got {text[name].iloc[row]!r}")
+        values[name] = column * factor
+    time_name = next(iter(quantities))
+    steps = np.diff(values[time_name])
+    if np.any(steps <= 0):
+        row = int(np.argmax(steps <= 0)) + 1
+        raise FileFormatError(f"{path}: line {lines[row]}, column '{time_name}': time must increase strictly, "
+                              f"got {text[time_name].iloc[row]!r} after {text[time_name].iloc[row - 1]!r}")
+    return {name: values[name] for name in quantities}
+
+
+def _data_line_numbers(path, n_rows):
+    """1-based line numbers of the data rows (after the header, skipping comments and blank lines)."""
+    numbers = []
+    with open(path, encoding="utf-8", errors="replace") as stream:
+        for number, line in enumerate(stream, start=1):
+            if line.strip() and not line.lstrip().startswith("#"):
+                numbers.append(number)
+    return numbers[1:n_rows + 1]
+
+
+def _sha256(path):
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stack", a=0, normal_force=49.0,
+               k_spring=55.0, h=10.0, H=100.0, V=0.01, time_unit=None, force_unit=None, position_unit=None):
+    """Convert a lab export (force CSV + positions CSV) into a time-series HDF5 file.
+
+    Parameters
+    ----------
+    force_csv, positions_csv : str or pathlib.Path
+        The two CSV files (layout in the module docstring).
+    output : str or pathlib.Path
+        HDF5 file to write (atomically).
+    n : int
+        Driven slabs (1 for the individual protocol).
+    n_slabs : int, optional
+        Slabs in the stack; the positions file has columns x1..x<n_slabs>.
+    protocol : {"stack", "individual"}, optional
+    a : int, optional
+        Slab driven alone (individual protocol); 0 for stack.
+    normal_force, k_spring, h, H, V : float, optional
+        N [N], K [N/mm], h [mm], H [mm], lever-top speed imposed during the run [mm/s]
+        (defaults: the paper's apparatus).
+    time_unit, force_unit, position_unit : str, optional
+        Units of columns whose header names none (see :data:`UNITS`).
+
+    Returns
+    -------
+    ExperimentRecord
+        What was written.
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        For a bad CSV file (naming file, column and line) or inconsistent metadata.
+    """
+    units = {"time": time_unit, "force": force_unit, "length": position_unit}
+    force = read_csv_columns(force_csv, {"t": "time", "F": "force"}, units)
+    position_columns = {"t": "time", **{f"x{i}": "length" for i in range(1, n_slabs + 1)}}
+    positions = read_csv_columns(positions_csv, position_columns, units)
+    x = np.column_stack([positions[f"x{i}"] for i in range(1, n_slabs + 1)])
+    record = ExperimentRecord(t_F=force["t"], F=force["F"], t_x=positions["t"], x=x, n=n, n_slabs=n_slabs,
+                              protocol=protocol, a=a, normal_force=normal_force, k_spring=k_spring, h=h, H=H, V=V)
+    source = {"force_csv": {"name": Path(force_csv).name, "sha256": _sha256(force_csv)},
+              "positions_csv": {"name": Path(positions_csv).name, "sha256": _sha256(positions_csv)}}
+    write_timeseries(output, record, attrs={"imported_from": source})
+    return record
