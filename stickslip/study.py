@@ -329,6 +329,12 @@ class Study:
         return code_hash(registry.get(kind, name).module)
 
     @staticmethod
+    def caption(figure):
+        """Return the caption of a figure: its plugin's summary, name and version."""
+        plugin = registry.get("figure", figure)
+        return f"{plugin.summary} (figure plugin ``{plugin.name}`` version {plugin.version}, {plugin.module})"
+
+    @staticmethod
     def dumps(params):
         """Return parameters as canonical JSON (what the rules pass to the jobs)."""
         return json.dumps(params, sort_keys=True)

@@ -5,6 +5,7 @@ Sub-commands: ``runs`` and ``events`` (filters, ``--format table|csv|json``),
 ``rebuild`` (recreate the database from the records under the results directory).
 """
 
+import os
 import sys
 from pathlib import Path
 
@@ -15,11 +16,11 @@ from ..h5io import FileFormatError
 FORMATS = ("table", "csv", "json")
 
 #: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
-RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "N", "regime",
+RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "blocks", "regime",
                "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
 
 EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",
-                 "interface", "slip", "time", "increment")
+                 "interface", "slip", "dmu", "multi", "time", "increment")
 
 
 def _common(parser, default_format="table"):
@@ -76,6 +77,14 @@ def add_parser(subparsers):
 
 
 def _print(frame, args, columns=None):
+    try:
+        _write(frame, args, columns)
+    except BrokenPipeError:  # `stickslip db events | head`: the reader stopped, not an error
+        sys.stdout = open(os.devnull, "w")
+    return 0
+
+
+def _write(frame, args, columns):
     if args.format == "table" and columns is not None and not args.all_columns:
         frame = frame[[c for c in columns if c in frame.columns]]
     if args.format == "csv":
@@ -87,7 +96,6 @@ def _print(frame, args, columns=None):
     else:
         with pd.option_context("display.max_rows", None, "display.max_columns", None, "display.width", 200):
             print(frame.to_string(index=False))
-    return 0
 
 
 def run_runs(args):

@@ -9,11 +9,13 @@ reading the import statements, without importing anything), plus the
 ``__init__.py`` of every package on the way (they run on import).
 
 Imports made by name at run time (``importlib.import_module("...")``) are not
-seen; plugins do not use them.
+seen; plugins do not use them. A third-party plugin (a module outside the
+package) is hashed by its own source file.
 """
 
 import ast
 import hashlib
+import importlib.util
 from functools import lru_cache
 from pathlib import Path
 
@@ -75,7 +77,8 @@ def module_sources(module):
     Parameters
     ----------
     module : str
-        Dotted module name inside the package, e.g. ``"stickslip.solvers.lever"``.
+        Dotted module name, e.g. ``"stickslip.solvers.lever"``; outside the
+        package, only the module's own file is returned.
 
     Returns
     -------
@@ -85,11 +88,14 @@ def module_sources(module):
     Raises
     ------
     ValueError
-        If ``module`` is not a module of the package.
+        If ``module`` has no source file.
     """
     start = _module_file(module)
     if start is None:
-        raise ValueError(f"{module!r} is not a module of the {PACKAGE} package (looked under {ROOT})")
+        spec = importlib.util.find_spec(module)
+        if spec is None or not spec.origin or not Path(spec.origin).is_file():
+            raise ValueError(f"module {module!r} has no source file to hash")
+        return (Path(spec.origin).resolve(),)
     seen = {}
     pending = [(module, start)]
     while pending:
@@ -127,7 +133,7 @@ def code_hash(module):
     """
     digest = hashlib.sha256()
     for path in module_sources(module):
-        digest.update(path.relative_to(ROOT.parent).as_posix().encode())
+        digest.update((path.relative_to(ROOT.parent).as_posix() if path.is_relative_to(ROOT) else path.name).encode())
         digest.update(b"\0")
         digest.update(path.read_bytes())
         digest.update(b"\0")

@@ -94,14 +94,19 @@ class Simulation(Base):
     n: Mapped[int | None] = mapped_column(Integer, index=True, doc="number of driven interfaces / slabs")
     a: Mapped[int | None] = mapped_column(Integer, doc="slab driven alone (individual protocol)")
     plates: Mapped[int | None] = mapped_column(Integer, doc="number of elastic plates (fem)")
-    N: Mapped[int | None] = mapped_column(Integer, doc="blocks per interface (fem)")
+    blocks: Mapped[int | None] = mapped_column(Integer, doc="N, blocks per interface (fem); SQLite names "
+                                                           "are case-insensitive, so not 'N' beside 'n'")
     k_drive: Mapped[float | None] = mapped_column(Float, doc="drive spring stiffness (solver units)")
     regime: Mapped[str | None] = mapped_column(String, index=True, doc="driving regime, e.g. stiff or compliant")
     seed: Mapped[int | None] = mapped_column(Integer)
 
 
 class SlipEvent(Base):
-    """The slip of one interface in one event, from an analysis output's ``slips`` table."""
+    """The slip of one interface in one event, from an analysis output's event table.
+
+    Numerical events come from the ``slip_interfaces`` table of ``numerical-events``,
+    experimental ones from the ``slips`` table of ``experiment-events``.
+    """
 
     __tablename__ = "slip_events"
     id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
@@ -113,8 +118,11 @@ class SlipEvent(Base):
                                                doc="numerical or experimental (NULL until its simulation is in)")
     event: Mapped[int] = mapped_column(Integer, doc="event index within the run")
     interface: Mapped[int | None] = mapped_column(Integer, index=True, doc="interface (slab) a, 1 = lowest")
-    slip: Mapped[float | None] = mapped_column(Float, doc="slip amplitude (unit in the analysis docs)")
-    time: Mapped[float | None] = mapped_column(Float, doc="time of the event (experimental) [s]")
+    slip: Mapped[float | None] = mapped_column(Float, doc="slip dR of the interface (experimental) [mm]")
+    dmu: Mapped[float | None] = mapped_column(Float, doc="drop of friction coefficient (experimental) [-] or "
+                                                        "of interface stress (numerical) [sig0]")
+    multi: Mapped[bool | None] = mapped_column(Boolean, doc="more than one interface slipped in the event")
+    time: Mapped[float | None] = mapped_column(Float, doc="time of the slip (experimental) [s]")
     increment: Mapped[int | None] = mapped_column(Integer, doc="increment of the event (numerical)")
     extra: Mapped[str | None] = mapped_column(Text, doc="the table's other columns, JSON")
 
@@ -134,7 +142,7 @@ Index("ix_slip_events_sim_interface", SlipEvent.simulation_run_id, SlipEvent.int
 #: Views created with the tables: name -> SELECT.
 VIEWS = {
     "slip_events_full": (
-        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.N, s.k_drive, s.regime, s.seed "
+        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.regime, s.seed "
         "FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
 }
 

@@ -11,7 +11,7 @@ What goes where (see :mod:`.database`):
 
 - every record -> ``runs`` and ``artifacts``;
 - solver records -> ``simulations`` (typed columns from the parameters);
-- analysis records -> ``slip_events``, from the ``slips`` table of the output;
+- analysis records -> ``slip_events``, from the output's event table (:data:`EVENT_TABLES`);
 - figure records -> ``figures``.
 """
 
@@ -30,15 +30,20 @@ from ..h5io import FileFormatError, open_file, read_table
 from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
 
-__all__ = ["ingest", "find_records", "SLIPS_TABLE", "EVENT_COLUMNS"]
+__all__ = ["ingest", "find_records", "EVENT_TABLES", "EVENT_COLUMNS"]
 
-#: Name of the table of slips in an analysis output.
-SLIPS_TABLE = "slips"
+#: Tables of an analysis output read into ``slip_events``, the first found: one row per
+#: (event, slipping interface). Numerical: ``slip_interfaces`` (events.plugin); experimental:
+#: ``slips`` (experiment.analysis).
+EVENT_TABLES = ("slip_interfaces", "slips")
 
-#: Columns of a slips table that map to typed columns of ``slip_events``; others go to ``extra``.
-EVENT_COLUMNS = ("event", "interface", "slip", "time", "increment")
+#: Column of an event table -> column of ``slip_events``; the table's other columns go to ``extra``.
+EVENT_COLUMNS = {"event": "event", "a": "interface", "dR": "slip", "dmu": "dmu", "t": "time",
+                 "increment": "increment", "multi": "multi"}
 
-SIMULATION_COLUMNS = ("protocol", "n", "a", "plates", "N", "k_drive", "regime", "seed")
+#: Column of ``simulations`` -> parameter (or root attribute of the simulation file) it comes from.
+SIMULATION_COLUMNS = {"protocol": "protocol", "n": "n", "a": "a", "plates": "plates", "blocks": "N",
+                      "k_drive": "k_drive", "regime": "regime", "seed": "seed"}
 
 #: An event's source is its simulation's (known once both records are in).
 SOURCE_FROM_SIMULATIONS = ("UPDATE slip_events SET source = (SELECT s.source FROM simulations AS s "
@@ -65,7 +70,7 @@ def find_records(results):
 
 @contextmanager
 def _locked(database):
-    lock_path = Path(f"{database}.lock")
+    lock_path = database.parent / f".{database.name}.lock"
     with open(lock_path, "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
@@ -101,32 +106,36 @@ def _artifact_rows(record):
             for direction, key in (("input", "inputs"), ("output", "outputs")) for entry in record[key]]
 
 
-def _source(simulation_file):
-    """``experimental`` for a file in the experimental time-series format (has ``/t_F``), else ``numerical``."""
-    with open_file(simulation_file) as handle:
-        return "experimental" if "t_F" in handle else "numerical"
-
-
 def _simulation_row(record, record_file):
-    params = record["params"]
+    """Typed columns from the parameters, else from the simulation file's root attributes."""
     path = record["outputs"][0]["path"]
-    row = {"run_id": record["run_id"], "solver": record["plugin"], "path": path,
-           "source": _source(_beside(record_file, path))}
-    row.update({column: params.get(column) for column in SIMULATION_COLUMNS})
+    with open_file(_beside(record_file, path)) as handle:
+        attrs = {key: _python(value) for key, value in handle.attrs.items()}
+        source = "experimental" if "t_F" in handle else "numerical"
+    row = {"run_id": record["run_id"], "solver": record["plugin"], "path": path, "source": source}
+    for column, name in SIMULATION_COLUMNS.items():
+        value = record["params"].get(name, attrs.get(name))
+        row[column] = value.decode() if isinstance(value, bytes) else value
     return row
 
 
 def _python(value):
-    """A numpy scalar as the Python scalar SQLite takes."""
-    return value.item() if hasattr(value, "item") else value
+    """A numpy scalar as the Python scalar SQLite takes (NaN as NULL)."""
+    value = value.item() if hasattr(value, "item") else value
+    return None if isinstance(value, float) and value != value else value
 
 
 def _event_rows(record, record_file):
     output = _beside(record_file, record["outputs"][0]["path"])
     with open_file(output) as handle:
-        if SLIPS_TABLE not in handle:
+        name = next((table for table in EVENT_TABLES if table in handle), None)
+        if name is None:
             return []
-        table = read_table(handle, SLIPS_TABLE)
+        table = read_table(handle, name)
+    if "single" in table.columns and "multi" not in table.columns:
+        table["multi"] = ~table.pop("single").astype(bool)
+    if "event" not in table.columns and "increment" in table.columns:
+        table.insert(0, "event", table["increment"].rank(method="dense").astype(int) - 1)
     simulation = record["inputs"][0]
     identity = {"analysis_run_id": record["run_id"], "simulation_run_id": Path(simulation["path"]).stem,
                 "analysis": record["plugin"], "solver": simulation["role"].partition(":")[2], "source": None}
@@ -134,7 +143,7 @@ def _event_rows(record, record_file):
     rows = []
     for index, item in enumerate(table.to_dict("records")):
         row = dict(identity)
-        row.update({column: _python(item.get(column)) for column in EVENT_COLUMNS})
+        row.update({column: _python(item.get(name)) for name, column in EVENT_COLUMNS.items()})
         if row["event"] is None:
             row["event"] = index
         row["extra"] = json.dumps({c: _python(item[c]) for c in extra_columns}) if extra_columns else None

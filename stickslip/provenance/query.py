@@ -26,13 +26,21 @@ def _engine(database):
     return engine_for(path, readonly=True)
 
 
+#: Integer columns that an outer join may fill with NULL: kept as integers (pandas "Int64").
+INTEGER_COLUMNS = ("n", "a", "plates", "blocks", "seed", "threads", "event", "interface", "increment")
+
+
 def _frame(database, statement):
     engine = _engine(database)
     try:
         with engine.connect() as connection:
-            return pd.read_sql(statement, connection)
+            frame = pd.read_sql(statement, connection)
     finally:
         engine.dispose()
+    for column in INTEGER_COLUMNS:
+        if column in frame.columns:
+            frame[column] = frame[column].astype("Int64")
+    return frame
 
 
 def _where(statement, filters):
@@ -62,7 +70,7 @@ def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=No
     -------
     pandas.DataFrame
         One row per run: the ``runs`` columns, then ``solver``, ``source``,
-        ``protocol``, ``n``, ``a``, ``plates``, ``N``, ``k_drive``, ``regime``
+        ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``regime``
         (NULL for runs that are not simulations); ordered by kind, plugin, run id.
 
     Notes
@@ -70,7 +78,7 @@ def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=No
     Cost: one indexed query; linear in the number of runs returned.
     """
     columns = [Simulation.solver, Simulation.source, Simulation.protocol, Simulation.n, Simulation.a,
-               Simulation.plates, Simulation.N, Simulation.k_drive, Simulation.regime]
+               Simulation.plates, Simulation.blocks, Simulation.k_drive, Simulation.regime]
     statement = (select(Run, *columns).outerjoin(Simulation, Simulation.run_id == Run.run_id)
                  .order_by(Run.kind, Run.plugin, Run.run_id))
     statement = _where(statement, [(Run.kind, kind), (Run.plugin, plugin), (Simulation.solver, solver),
@@ -100,7 +108,7 @@ def events(database=DEFAULT_DATABASE, *, solver=None, analysis=None, source=None
     -------
     pandas.DataFrame
         The ``slip_events_full`` view: one row per slip of one interface in one
-        event, with ``protocol``, ``n``, ``a``, ``plates``, ``N``, ``k_drive``,
+        event, with ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
         ``regime``, ``seed``; ordered by simulation, event, interface.
 
     Notes

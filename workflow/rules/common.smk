@@ -1,0 +1,52 @@
+# The study: the config validated (each plugin section against its plugin's JSON-Schema, defaults
+# filled) and expanded into jobs by stickslip.study before any rule is defined.
+
+import json
+import tempfile
+from pathlib import Path
+
+import yaml
+from snakemake.exceptions import WorkflowError
+
+from stickslip.params import ParameterError
+from stickslip.provenance.code import code_hash
+from stickslip.provenance.record import record_path
+from stickslip.study import PATHS, Study, normalise, plugin_sections
+
+
+def _validate_plugin_sections(config):
+    """Validate every plugin section against its plugin's schema, naming the key on failure."""
+    normalise(config)
+    with tempfile.TemporaryDirectory() as folder:
+        for index, (key, section, schema) in enumerate(plugin_sections(config)):
+            # one file per section: Snakemake caches a schema file's contents by path
+            path = Path(folder) / f"section{index}.schema.yaml"
+            path.write_text(yaml.safe_dump({"$schema": "https://json-schema.org/draft/2020-12/schema", **schema}))
+            try:
+                validate(section, str(path))
+            except WorkflowError as error:
+                detail = str(error.args[0]).removeprefix("Error validating config file.").strip()
+                raise WorkflowError(f"config key {key}: {detail}") from None
+
+
+try:
+    _validate_plugin_sections(config)
+    STUDY = Study(config)
+except ParameterError as error:
+    raise WorkflowError(str(error)) from None
+
+
+#: The software of all jobs under `--software-deployment-method conda` (see the file's comments).
+CONDA_ENV = "../envs/stickslip.yaml"
+
+
+wildcard_constraints:
+    solver=r"[a-z0-9][A-Za-z0-9_-]*",
+    analysis=r"[a-z0-9][A-Za-z0-9_-]*",
+    run_id=r"[0-9a-f]{16}",
+    mesh_id=r"[0-9a-f]{16}",
+
+
+def record_of(pattern):
+    """The provenance record beside an output pattern."""
+    return record_path(pattern).as_posix()

@@ -1,0 +1,16 @@
+# Layered meshes read by the solvers that declare the "mesh" input (fem).
+
+
+rule mesh:
+    output:
+        h5=PATHS["mesh"],
+        record=record_of(PATHS["mesh"]),
+    log:
+        "logs/mesh/{mesh_id}.log",
+    params:
+        params=lambda wildcards: Study.dumps(STUDY.meshes[wildcards.mesh_id]),
+        code=Study.code("mesh", "mesh") if STUDY.meshes else "",
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/mesh.py"

@@ -1,0 +1,5 @@
+"""Rule mesh: write one mesh (stickslip.workflow_api.run_mesh)."""
+
+from stickslip.workflow_api import run_mesh
+
+run_mesh(snakemake.params.params, snakemake.output.h5, snakemake.output.record, snakemake.log[0])
