@@ -59,7 +59,6 @@ class LeverParams:
     B: tuple[float, ...] = param((0.045, 0.032, 0.055, 0.038, 0.050),
                                  "aging rate per interface (one value: all)", exclusive_minimum=0)
     T0: float = param(1.0, "aging time scale T0", unit="s", exclusive_minimum=0)
-    strength_offset: float = param(0.05, "strength above mu_d gained however short the stick", minimum=0)
     threshold_noise: float = param(0.015, "scale of the half-normal threshold excess (annealed disorder)",
                                    minimum=0)
     creep_velocity: tuple[float, ...] = param(
@@ -95,12 +94,11 @@ class LeverParams:
                 raise ParameterError(f"parameter '{name}': expected 1 or n_slabs={self.n_slabs} values, "
                                      f"got {len(getattr(self, name))}")
         fastest = apparatus(self).loading_rates().max() * self.slip_duration
-        heals = self.strength_offset + np.min(per_interface(self, "B")) * np.log1p(self.slip_duration / self.T0)
+        heals = np.min(per_interface(self, "B")) * np.log1p(self.slip_duration / self.T0)
         if heals <= fastest:
             raise ParameterError(
-                f"parameter 'B': the weakest healing during a slip, strength_offset + B ln(1 + slip_duration/T0) = "
-                f"{heals:.3g}, must exceed the loading during a slip, {fastest:.3g}, or an interface slips "
-                f"again before it heals")
+                f"parameter 'B': the weakest aging, B ln(1 + slip_duration/T0) = {heals:.3g}, must exceed the "
+                f"loading during a slip, {fastest:.3g}, or an interface slips again before it heals")
 
 
 def per_interface(params, name):
@@ -126,7 +124,7 @@ def friction_law(params):
     n_driven = params.n if params.protocol == "stack" else 1
     scale = (n_driven - 1) / max(params.n_slabs - 1, 1)
     return FrictionLaw(mu_d=per_interface(params, "mu_d"), B=per_interface(params, "B"), T0=params.T0,
-                       offset=params.strength_offset, threshold_noise=params.threshold_noise,
+                       threshold_noise=params.threshold_noise,
                        creep_velocity=scale * per_interface(params, "creep_velocity"),
                        creep_onset=params.creep_onset, trigger_margin=params.trigger_margin)
 
