@@ -130,13 +130,14 @@ def test_aging_law_is_the_threshold_without_disorder():
     params = quiet(n=3, threshold_noise=0.0, B=(0.045, 0.03, 0.06, 0.04, 0.05))
     _, truth, _ = simulate(params)
     B = np.array(params.B)[truth["a"] - 1]
-    expected = params.mu_d[0] + B * np.log1p(truth["age"] / params.T0)
+    expected = params.mu_d[0] + params.strength_offset + B * np.log1p(truth["age"] / params.T0)
     np.testing.assert_allclose(truth["mu_before"], expected, rtol=0, atol=1e-12)
-    assert np.all(truth["excess"] == 0.0)
+    assert params.strength_offset > 0 and np.all(truth["excess"] == params.strength_offset)
     for a, rows in truth.groupby("a"):
         np.testing.assert_allclose(rows["T"].to_numpy()[1:], np.diff(rows["t_start"]), rtol=1e-12)
         assert math.isnan(rows["T"].iloc[0])
-        np.testing.assert_allclose(rows["dmu"], B[rows.index] * np.log1p(rows["age"]), atol=1e-12)
+        np.testing.assert_allclose(rows["dmu"], params.strength_offset + B[rows.index] * np.log1p(rows["age"]),
+                                   atol=1e-12)
 
 
 @pytest.mark.parametrize("a", [1, 3])

@@ -57,7 +57,7 @@ def test_sensor_noise_does_not_change_the_slips():
     ({"protocol": "individual"}, "parameter 'a': expected 1..n_slabs=5 for the individual protocol"),
     ({"protocol": "individual", "a": 2, "n": 3}, "parameter 'n': must be 1 for the individual protocol"),
     ({"B": "0.05,0.04"}, "parameter 'B': expected 1 or n_slabs=5 values, got 2"),
-    ({"B": "0.001", "n": 5}, "parameter 'B': the weakest aging"),
+    ({"B": "0.001", "n": 5, "strength_offset": 0}, "parameter 'B': the weakest healing during a slip"),
     ({"protocol": "sideways"}, "parameter 'protocol'"),
 ])
 def test_parameter_errors_name_the_field(values, message):

@@ -56,13 +56,14 @@ class LeverParams:
     V: float = param(0.01, "lever-top speed V (individual protocol: the lever moves at V/a)", unit="mm/s",
                      exclusive_minimum=0)
     mu_d: tuple[float, ...] = param((0.35,), "dynamic friction level per interface (one value: all)", minimum=0)
-    B: tuple[float, ...] = param((0.045, 0.032, 0.055, 0.038, 0.050),
+    B: tuple[float, ...] = param((0.030, 0.018, 0.039, 0.023, 0.034),
                                  "aging rate per interface (one value: all)", exclusive_minimum=0)
     T0: float = param(1.0, "aging time scale T0", unit="s", exclusive_minimum=0)
+    strength_offset: float = param(0.08, "strength above mu_d gained however short the stick", minimum=0)
     threshold_noise: float = param(0.015, "scale of the half-normal threshold excess (annealed disorder)",
                                    minimum=0)
     creep_velocity: tuple[float, ...] = param(
-        (0.002, 0.001, 0.0, 0.0, 0.0),
+        (0.0015, 0.00075, 0.0, 0.0, 0.0),
         "creep velocity per interface with all slabs driven; scaled by (n-1)/(n_slabs-1) (one value: all)",
         unit="mm/s", minimum=0)
     creep_onset: float = param(0.8, "creep starts at this fraction of the strength above mu_d",
@@ -94,11 +95,12 @@ class LeverParams:
                 raise ParameterError(f"parameter '{name}': expected 1 or n_slabs={self.n_slabs} values, "
                                      f"got {len(getattr(self, name))}")
         fastest = apparatus(self).loading_rates().max() * self.slip_duration
-        heals = np.min(per_interface(self, "B")) * np.log1p(self.slip_duration / self.T0)
+        heals = self.strength_offset + np.min(per_interface(self, "B")) * np.log1p(self.slip_duration / self.T0)
         if heals <= fastest:
             raise ParameterError(
-                f"parameter 'B': the weakest aging, B ln(1 + slip_duration/T0) = {heals:.3g}, must exceed the "
-                f"loading during a slip, {fastest:.3g}, or an interface slips again before it heals")
+                f"parameter 'B': the weakest healing during a slip, strength_offset + B ln(1 + slip_duration/T0) = "
+                f"{heals:.3g}, must exceed the loading during a slip, {fastest:.3g}, or an interface slips "
+                f"again before it heals")
 
 
 def per_interface(params, name):
@@ -124,7 +126,7 @@ def friction_law(params):
     n_driven = params.n if params.protocol == "stack" else 1
     scale = (n_driven - 1) / max(params.n_slabs - 1, 1)
     return FrictionLaw(mu_d=per_interface(params, "mu_d"), B=per_interface(params, "B"), T0=params.T0,
-                       threshold_noise=params.threshold_noise,
+                       offset=params.strength_offset, threshold_noise=params.threshold_noise,
                        creep_velocity=scale * per_interface(params, "creep_velocity"),
                        creep_onset=params.creep_onset, trigger_margin=params.trigger_margin)
 

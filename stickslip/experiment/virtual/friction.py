@@ -2,12 +2,12 @@
 
 Interface ``i`` sticks until its friction coefficient reaches its static strength::
 
-    mu_s,i(T) = mu_d,i + eps + B_i ln(1 + T / T0)
+    mu_s,i(T) = mu_d,i + eps + B_i ln(1 + T / T0),     eps = offset + threshold_noise |xi|
 
 with ``T`` the time since the onset of its previous slip (the paper's ``T_a``), ``mu_d,i``
-its dynamic level (a slip drops ``mu_i`` to it), ``B_i`` its aging rate and ``eps >= 0`` a
-threshold excess drawn anew after every slip (annealed disorder; half-normal with scale
-``threshold_noise``). ``ln(1 + T/T0)`` instead of ``ln(T/T0)`` keeps the strength above
+its dynamic level (a slip drops ``mu_i`` to it), ``B_i`` its aging rate and ``eps`` the
+threshold excess: a fixed ``offset`` (the strength gained however short the stick) plus
+annealed disorder, ``xi`` standard normal, drawn anew after every slip. ``ln(1 + T/T0)`` instead of ``ln(T/T0)`` keeps the strength above
 ``mu_d`` for ``T < T0`` (the pure law is negative there and would make an interface slip
 again right after a slip); for ``T >> T0`` they differ by ``B T0 / T``.
 
@@ -40,8 +40,10 @@ class FrictionLaw:
         Aging rate per interface, float64 [n_slabs] (>= 0).
     T0 : float
         Aging time scale [s].
+    offset : float
+        Part of the threshold excess common to every stick (>= 0).
     threshold_noise : float
-        Scale of the half-normal threshold excess ``eps`` (0: no disorder).
+        Scale of the half-normal part of the threshold excess (0: no disorder).
     creep_velocity : numpy.ndarray
         Creep (slow-slip) velocity per interface [mm/s], float64 [n_slabs] (0: no creep).
     creep_onset : float
@@ -54,6 +56,7 @@ class FrictionLaw:
     mu_d: np.ndarray
     B: np.ndarray
     T0: float
+    offset: float
     threshold_noise: float
     creep_velocity: np.ndarray
     creep_onset: float
@@ -72,8 +75,8 @@ class FrictionLaw:
         return self.mu_d + excess + self.B * np.log1p(T / self.T0)
 
     def draw_excess(self, rng, size):
-        """Draw ``size`` threshold excesses eps = threshold_noise |xi|, xi standard normal."""
-        return self.threshold_noise * np.abs(rng.standard_normal(size))
+        """Draw ``size`` threshold excesses eps = offset + threshold_noise |xi|, xi standard normal."""
+        return self.offset + self.threshold_noise * np.abs(rng.standard_normal(size))
 
 
 def first_crossing(mu, rate, level, slope, T, T0):
