@@ -1,0 +1,200 @@
+"""Panels that several experimental figures draw: distributions per ``n``, the aging plot, the
+slow-slip fraction and position time series.
+
+Every function draws on a given :class:`matplotlib.axes.Axes` and sets its labels; colours follow
+:func:`stickslip.figures.style.interface_color` for interfaces and
+:func:`stickslip.figures.style.n_color` for ``n``; the interface driven alone is black.
+"""
+
+import numpy as np
+from matplotlib.ticker import NullFormatter
+
+from ..experiment import aging, kinematics
+from .experimental_data import a_style, individual_style, n_style, plot_density
+from .style import interface_color
+
+__all__ = ["LABELS", "single_slips", "linear_edges", "log_edges", "distributions_by_n", "aging_panel",
+           "disorder_law_lines", "slow_slip_fraction_panel", "positions_panel"]
+
+#: Axis labels of the slip quantities (with units).
+LABELS = {"dF": r"$\Delta F$ (N)", "dmu": r"$\Delta\mu_a$", "T": r"$T_a$ (s)", "B_a": r"$B_a$",
+          "dR": r"$\Delta R_a$ (mm)", "dR_from_dF": r"$\Delta R_a(\Delta F)$ (mm)"}
+
+
+def single_slips(slips, protocol=None):
+    """The slips of single-interface events (``multi`` False), optionally of one protocol."""
+    keep = ~slips["multi"].to_numpy(dtype=bool)
+    if protocol is not None:
+        keep &= (slips["protocol"] == protocol).to_numpy()
+    return slips[keep]
+
+
+def linear_edges(values, bins=25):
+    """``bins`` equal bins from 0 to the 99.5th percentile of the finite ``values``."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    top = np.percentile(values, 99.5) if values.size else 1.0
+    return np.linspace(0.0, top * 1.02 if top > 0 else 1.0, bins + 1)
+
+
+def log_edges(values, per_decade=8):
+    """Logarithmic bins (``per_decade`` per factor 10) that cover the positive finite ``values``."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values) & (values > 0)]
+    if not values.size:
+        return np.logspace(0, 1, per_decade + 1)
+    low = np.floor(np.log10(values.min()) * per_decade)
+    high = np.ceil(np.log10(values.max()) * per_decade)
+    return 10.0 ** (np.arange(low, max(high, low + 1) + 1) / per_decade)
+
+
+def distributions_by_n(ax, slips, a, column, edges, *, individual=True, logarithmic=False):
+    """``P(column)`` of the single slips of interface ``a``: one line per ``n``, the interface
+    driven alone in black.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    slips : pandas.DataFrame
+        Slips of all runs (:func:`~stickslip.figures.experimental_data.load_slips`).
+    a : int
+        Interface.
+    column : str
+        Quantity (a key of :data:`LABELS`).
+    edges : numpy.ndarray
+        Bin edges (in units of ``column``).
+    individual : bool
+        Also draw the individual-protocol slips of ``a``.
+    logarithmic : bool
+        Show the density of ``log10(column)`` on a logarithmic axis (for quantities spread over
+        decades, such as ``T_a``; ``edges`` then logarithmic).
+    """
+    single = single_slips(slips)
+    groups = [(stack_n, n_style(stack_n), {}) for stack_n in
+              sorted(single.loc[(single["protocol"] == "stack") & (single["a"] == a), "n"].unique())]
+    if individual:
+        groups.append((None, individual_style(), {"linestyle": "--"}))
+    for n, style, extra in groups:
+        part = single[(single["a"] == a) & ((single["protocol"] == "individual") if n is None
+                                            else (single["protocol"] == "stack") & (single["n"] == n))]
+        plot_density(ax, part[column], edges, logarithmic=logarithmic, **style, **extra)
+    name = LABELS[column].split(" (")[0]
+    ax.set_xlabel(LABELS[column])
+    if logarithmic:
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_ylabel(f"$P(\\log_{{10}} {name.strip('$')})$")
+    else:
+        ax.set_ylabel(f"$P$({name})")
+
+
+def aging_panel(ax, slips, *, color_by="a", t0=aging.T0, fit=True):
+    """``dmu_a`` against ``T_a`` (semi-logarithmic), with log-binned means and the aging fit.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    slips : pandas.DataFrame
+        Slips to show (single slips with a waiting time are used).
+    color_by : {"a", "n"}
+        Colour by interface (marker by ``n``) or by ``n`` (marker by interface).
+    t0 : float
+        Aging time scale [s].
+    fit : bool
+        Draw the binned means (black, error bar = standard deviation) and the fitted law.
+
+    Returns
+    -------
+    stickslip.experiment.aging.AgingFit or None
+    """
+    data = single_slips(slips)
+    data = data[np.isfinite(data["T"].to_numpy(dtype=float)) & np.isfinite(data["dmu"].to_numpy(dtype=float))]
+    other = "n" if color_by == "a" else "a"
+    for key in sorted(data[color_by].unique()):
+        for second in sorted(data[other].unique()):
+            part = data[(data[color_by] == key) & (data[other] == second)]
+            if part.empty:
+                continue
+            colour = (a_style if color_by == "a" else n_style)(key)["color"]
+            marker = (n_style if color_by == "a" else a_style)(second)["marker"]
+            ax.plot(part["T"], part["dmu"], linestyle="none", marker=marker, markersize=2.5, alpha=0.35,
+                    color=colour, markeredgewidth=0)
+    # Legend proxies: colours, then markers.
+    for key in sorted(data[color_by].unique()):
+        style = (a_style if color_by == "a" else n_style)(key)
+        ax.plot([], [], linestyle="none", marker="o", color=style["color"], label=style["label"], markersize=4)
+    for second in sorted(data[other].unique()):
+        style = (n_style if color_by == "a" else a_style)(second)
+        ax.plot([], [], linestyle="none", marker=style["marker"], color="grey", label=style["label"], markersize=4)
+    ax.set_xscale("log")
+    ax.set_xlabel(LABELS["T"])
+    ax.set_ylabel(LABELS["dmu"])
+    if not fit or data.empty:
+        return None
+    try:
+        result = aging.fit_aging(data["T"], data["dmu"], t0=t0)
+    except ValueError:
+        return None
+    bins = result.bins
+    ax.errorbar(bins["T"], bins["dmu_mean"], yerr=bins["dmu_std"], color="black", marker="s", markersize=4,
+                linestyle="none", capsize=2, zorder=5)
+    T = np.logspace(np.log10(max(t0, bins["T_low"].min())), np.log10(bins["T_high"].max()), 50)
+    ax.plot(T, result.B * np.log(T / t0), color="black", linestyle=":", zorder=6,
+            label=rf"$B = {result.B:.3f} \pm {result.B_error:.3f}$")
+    return result
+
+
+def disorder_law_lines(ax, slips, T_range):
+    """Disorder law of the individual protocol, ``dmu_a = (d mu_a/dt) T_a``, one line per run
+    constants (black, solid); runs with equal loading rates share a line."""
+    alone = slips[slips["protocol"] == "individual"]
+    rates = {round(float(kinematics.mu_loading_rate(a, 1, "individual", k_spring=K, h=h, H=H, V=V,
+                                                    normal_force=N)), 12)
+             for a, K, h, H, V, N in alone[["a", "k_spring", "h", "H", "V", "normal_force"]].drop_duplicates()
+             .itertuples(index=False)}
+    T = np.linspace(*T_range, 50)
+    for index, rate in enumerate(sorted(rates)):
+        ax.plot(T, rate * T, color="black", linewidth=1.2,
+                label=r"$\Delta\mu_a = K T_a h \dot\gamma / N$" if index == 0 else None)
+
+
+def slow_slip_fraction_panel(ax, interfaces):
+    """``R_slow`` against ``n`` per interface: mean over runs, error bars from min to max.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    interfaces : pandas.DataFrame
+        :func:`~stickslip.figures.experimental_data.load_interfaces` of the stack runs.
+    """
+    stack = interfaces[(interfaces["protocol"] == "stack") & interfaces["driven"].to_numpy(dtype=bool)]
+    for a, part in stack.groupby("a"):
+        summary = part.groupby("n")["R_slow"].agg(["mean", "min", "max"]).reset_index()
+        offset = 0.06 * (a - 3)
+        ax.errorbar(summary["n"] + offset, summary["mean"],
+                    yerr=[summary["mean"] - summary["min"], summary["max"] - summary["mean"]],
+                    capsize=2, markersize=4, **a_style(a))
+    ax.axhline(0.0, color="grey", linewidth=0.5)
+    ax.set_xlabel("$n$")
+    ax.set_ylabel(r"$R_\mathrm{slow}$")
+    ax.set_xticks(sorted(stack["n"].unique()))
+
+
+def positions_panel(ax, record, interfaces, t_range):
+    """``R_i(t) - R_i(t_0)`` of the interfaces ``interfaces`` over ``t_range`` (``t_0`` its start).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    record : stickslip.experiment.timeseries.ExperimentRecord
+    interfaces : iterable of int
+    t_range : tuple of float
+        ``(t_0, t_1)`` [s].
+    """
+    window = (record.t_x >= t_range[0]) & (record.t_x <= t_range[1])
+    R = record.R[window]
+    for i in interfaces:
+        ax.plot(record.t_x[window], R[:, i - 1] - R[0, i - 1], color=interface_color(i), linewidth=1.0,
+                label=f"$i = {i}$")
+    ax.set_xlabel("$t$ (s)")
+    ax.set_ylabel(r"$R_i(t) - R_i(t_0)$ (mm)")

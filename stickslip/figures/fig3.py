@@ -1,0 +1,92 @@
+"""Fig. 3: lever force and slab positions of one run, P(dF) of interface 1 for every n, and the
+measured slip against the slip predicted from the force drop."""
+
+import dataclasses
+
+import numpy as np
+from matplotlib.ticker import NullFormatter
+
+from .. import registry
+from ..params import param
+from .experimental_data import EVENTS, LEVER, a_style, example_run, label_panels, load_slips
+from .experimental_panels import LABELS, distributions_by_n, linear_edges, positions_panel, single_slips
+from .style import interface_color, plt, save_figure
+
+VERSION = "1"
+
+
+@dataclasses.dataclass(frozen=True)
+class Fig3Params:
+    """Which run and which stretch of time panel (a) shows."""
+
+    n_example: int = param(4, "driven slabs of the run shown in panel (a)", minimum=1)
+    t_from: float = param(5400.0, "start t_0 of the excerpt (the run's last stretch if it is shorter)", unit="s",
+                          minimum=0)
+    duration: float = param(400.0, "length of the excerpt", unit="s", exclusive_minimum=0)
+
+
+def _excerpt(record, t_from, duration):
+    end = min(t_from + duration, record.t_x[-1])
+    return (max(record.t_x[0], end - duration), end)
+
+
+def force_panel(ax, record, slips, t_range):
+    """``F(t)`` in grey with every force drop drawn in the colour of its interface (black if multi)."""
+    window = (record.t_F >= t_range[0]) & (record.t_F <= t_range[1])
+    ax.plot(record.t_F[window], record.F[window], color="0.6", linewidth=0.6)
+    shown = slips[(slips["t_start"] >= t_range[0]) & (slips["t_end"] <= t_range[1])].drop_duplicates("event")
+    for _, slip in shown.iterrows():
+        before = np.searchsorted(record.t_F, slip["t_start"], side="right") - 1
+        colour = "black" if slip["multi"] else interface_color(slip["a"])
+        ax.plot([slip["t"], slip["t"]], [record.F[before], record.F[before] - slip["dF"]], color=colour,
+                linewidth=2.0, solid_capstyle="butt")
+    for a in sorted(shown["a"].unique()):
+        ax.plot([], [], color=interface_color(a), linewidth=2.0, label=f"$a = {a}$")
+    ax.set_ylabel("$F$ (N)")
+    ax.legend(fontsize=7, ncol=5, loc="upper left", handlelength=1.0, columnspacing=0.8, frameon=False,
+              bbox_to_anchor=(0.08, 1.0))
+
+
+@registry.register("figure", "fig3", VERSION, Fig3Params, inputs=(LEVER, EVENTS))
+def run(params, inputs, output):
+    """Fig. 3: F(t) and R_i(t) excerpt, P(dF) for a = 1 and every n, dR_a measured vs from dF."""
+    record, run_slips = example_run(inputs[EVENTS], inputs[LEVER], n=params.n_example)
+    slips = load_slips(inputs[EVENTS])
+    fig = plt.figure(figsize=(8.0, 5.0), layout="constrained")
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.5, 1.0))
+    ax_F = fig.add_subplot(grid[0, 0])
+    ax_R = fig.add_subplot(grid[1, 0], sharex=ax_F)
+    ax_dF = fig.add_subplot(grid[0, 1])
+    ax_dR = fig.add_subplot(grid[1, 1])
+    t_range = _excerpt(record, params.t_from, params.duration)
+    force_panel(ax_F, record, run_slips, t_range)
+    ax_F.text(0.98, 0.97, f"$n = {record.n}$", transform=ax_F.transAxes, ha="right", va="top", fontsize=9)
+    ax_F.tick_params(labelbottom=False)
+    positions_panel(ax_R, record, range(1, record.n_slabs + 1), t_range)
+    ax_R.legend(fontsize=7, ncol=5, loc="upper left", handlelength=1.0, columnspacing=0.8, frameon=False,
+                bbox_to_anchor=(0.08, 1.0))
+
+    stack = single_slips(slips, "stack")
+    one = stack[stack["a"] == 1]
+    distributions_by_n(ax_dF, slips, 1, "dF", linear_edges(one["dF"], 30), individual=False)
+    ax_dF.legend(fontsize=7, title="$a = 1$", title_fontsize=7)
+
+    for a in sorted(stack["a"].unique()):
+        part = stack[stack["a"] == a]
+        ax_dR.plot(part["dR_from_dF"], part["dR"], linestyle="none", markersize=2.5, alpha=0.4,
+                   markeredgewidth=0, **{**a_style(a), "label": None})
+        ax_dR.plot([], [], linestyle="none", markersize=4, **a_style(a))
+    limits = np.array([np.nanmin(stack[["dR", "dR_from_dF"]].to_numpy()), np.nanmax(stack[["dR", "dR_from_dF"]].to_numpy())])
+    limits = np.array([max(limits[0], 1e-3) / 1.2, limits[1] * 1.2])
+    ax_dR.plot(limits, limits, color="black", linewidth=0.8, linestyle="--", label=r"$y = x$")
+    ax_dR.set_xscale("log")
+    ax_dR.set_yscale("log")
+    for axis in (ax_dR.xaxis, ax_dR.yaxis):
+        axis.set_minor_formatter(NullFormatter())
+    ax_dR.set_xlim(limits)
+    ax_dR.set_ylim(limits)
+    ax_dR.set_xlabel(LABELS["dR_from_dF"])
+    ax_dR.set_ylabel(r"$\Delta R_a$ measured (mm)")
+    ax_dR.legend(fontsize=7, loc="upper left")
+    label_panels([ax_F, ax_dF, ax_dR])
+    save_figure(fig, output)

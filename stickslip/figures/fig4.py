@@ -1,0 +1,38 @@
+"""Fig. 4: P(dmu_a) of interfaces a = 1..4 for every n, with the interface driven alone in black."""
+
+import dataclasses
+
+from .. import registry
+from ..params import param
+from .experimental_data import EVENTS, label_panels, load_slips
+from .experimental_panels import distributions_by_n, linear_edges, single_slips
+from .style import plt, save_figure
+
+VERSION = "1"
+
+
+@dataclasses.dataclass(frozen=True)
+class Fig4Params:
+    """Binning of the distributions."""
+
+    interfaces: int = param(4, "interfaces a = 1..interfaces shown, one panel each (the paper: 4)", minimum=1)
+    bins: int = param(25, "bins of each density, from 0 to the 99.5th percentile of dmu_a", minimum=2)
+
+
+@registry.register("figure", "fig4", VERSION, Fig4Params, inputs=(EVENTS,))
+def run(params, inputs, output):
+    """Fig. 4: P(dmu_a) for a = 1..4 and every n; n = 1 individual in black."""
+    slips = load_slips(inputs[EVENTS])
+    single = single_slips(slips)
+    columns = 2 if params.interfaces > 1 else 1
+    rows = -(-params.interfaces // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(3.4 * columns, 2.7 * rows), layout="constrained", squeeze=False)
+    for a, ax in zip(range(1, params.interfaces + 1), axes.ravel()):
+        edges = linear_edges(single.loc[single["a"] == a, "dmu"], params.bins)
+        distributions_by_n(ax, slips, a, "dmu", edges)
+        ax.text(0.97, 0.95, f"$a = {a}$", transform=ax.transAxes, ha="right", va="top")
+        ax.legend(fontsize=6.5, loc="best", frameon=False)
+    for ax in axes.ravel()[params.interfaces:]:
+        ax.set_visible(False)
+    label_panels(axes.ravel()[:params.interfaces])
+    save_figure(fig, output)
