@@ -51,6 +51,8 @@ PROTOCOLS = ("stack", "individual")
 _DATASETS = ("t_F", "F", "t_x", "x")
 _INT_ATTRS = ("n", "n_slabs", "a")
 _FLOAT_ATTRS = ("normal_force", "k_spring", "h", "H", "V")
+# Lossless and deterministic; halves a 6000 s run (6.2 -> 2.9 MB) for ~0.1 s of writing.
+_COMPRESSION = {"compression": "gzip", "compression_opts": 1, "shuffle": True}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,7 +181,7 @@ def validate_record(record, source="record"):
 
 
 def write_timeseries(path, record, *, attrs=None, tables=None):
-    """Write a record to an HDF5 file (atomically; equal inputs give equal bytes).
+    """Write a record to an HDF5 file (atomically; equal inputs give equal bytes; gzip-compressed).
 
     Parameters
     ----------
@@ -207,7 +209,7 @@ def write_timeseries(path, record, *, attrs=None, tables=None):
         raise ValueError(f"extra attributes/tables must not reuse the format's names: {', '.join(clashes)}")
     with h5io.atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
         for name in _DATASETS:
-            h5io.write_dataset(f, name, np.asarray(getattr(record, name), dtype=np.float64))
+            h5io.write_dataset(f, name, np.asarray(getattr(record, name), dtype=np.float64), **_COMPRESSION)
         for name in _INT_ATTRS:
             f.attrs[name] = int(getattr(record, name))
         for name in _FLOAT_ATTRS:
