@@ -31,6 +31,9 @@ __all__ = ["prepare_environment", "run_mesh", "run_simulation", "run_analysis", 
 def prepare_environment(threads, numba_cache=""):
     """Set the numba environment of a job; call before anything imports numba.
 
+    (In a process that has imported numba already, as a test, ``NUMBA_NUM_THREADS``
+    no longer matters; the jobs also call :func:`stickslip.numba_options.set_num_threads`.)
+
     Parameters
     ----------
     threads : int
@@ -47,10 +50,10 @@ def prepare_environment(threads, numba_cache=""):
     """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
-    if "numba" in sys.modules:
-        raise RuntimeError("prepare_environment must run before numba is imported")
     os.environ["NUMBA_NUM_THREADS"] = str(int(threads))
     if numba_cache == "job":
+        if "numba" in sys.modules:
+            raise RuntimeError("numba_cache='job' needs prepare_environment before numba is imported")
         cache = tempfile.mkdtemp(prefix="stickslip-numba-")
         os.environ["NUMBA_CACHE_DIR"] = cache
         return cache

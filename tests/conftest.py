@@ -1,5 +1,6 @@
 """Shared fixtures: the toy plugin distribution (entry points) and a workflow copy."""
 
+import json
 import shutil
 import sys
 from pathlib import Path
@@ -59,3 +60,37 @@ def copy_workflow(destination):
 def python_path(*extra):
     """A PYTHONPATH with ``extra`` directories first."""
     return ":".join([*map(str, extra), *sys.path[1:]])
+
+
+@pytest.fixture
+def toy_results(tmp_path, toy_plugins, monkeypatch):
+    """Run the toy study (2 simulations, their analyses, 1 figure) through the workflow's job functions.
+
+    Returns
+    -------
+    list[pathlib.Path]
+        The provenance records, relative to the working directory ``tmp_path``.
+    """
+    from stickslip.params import parse_params
+    from stickslip.workflow_api import run_analysis, run_figure, run_simulation
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "1")
+    records, sims, events = [], [], []
+    solver = registry.get("solver", "toy-spring-block")
+    for seed in (1, 2):
+        values = {"seed": seed, "slips": 4}
+        run = registry.run_id(solver, parse_params(solver.params, values))
+        sim = f"results/sim/toy-spring-block/{run}.h5"
+        run_simulation("toy-spring-block", json.dumps(values), sim,
+                       sim.replace(".h5", ".provenance.json"), f"logs/{run}.log", inputs={}, threads=1)
+        event = f"results/events/toy-slips/toy-spring-block/{run}.h5"
+        run_analysis("toy-slips", "{}", sim, event, event.replace(".h5", ".provenance.json"), f"logs/e{run}.log")
+        sims.append(sim)
+        events.append(event)
+        records += [Path(sim.replace(".h5", ".provenance.json")), Path(event.replace(".h5", ".provenance.json"))]
+    inputs = {"solver:toy-spring-block": sims, "analysis:toy-slips": events}
+    run_figure("toy-force", "{}", json.dumps(inputs), "results/figures/toy-force.pdf",
+               "results/figures/toy-force.provenance.json", "logs/figure.log")
+    records.append(Path("results/figures/toy-force.provenance.json"))
+    return records

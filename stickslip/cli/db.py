@@ -117,15 +117,14 @@ def run_events(args):
 
 
 def run_sql(args):
-    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors."""
-    import sqlalchemy.exc
-
+    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2."""
     from ..provenance import query
 
     try:
         frame = query.sql(args.query, args.db)
-    except sqlalchemy.exc.OperationalError as error:
-        raise FileFormatError(f"{args.db}: {error.orig}") from None
+    except query.QueryError as error:
+        print(f"stickslip: error: {error}", file=sys.stderr)
+        return 2
     return _print(frame, args)
 
 

@@ -111,7 +111,9 @@ class SlipEvent(Base):
     __tablename__ = "slip_events"
     id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
     analysis_run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), index=True)
-    simulation_run_id: Mapped[str] = mapped_column(String(16), index=True)
+    simulation_run_id: Mapped[str] = mapped_column(String(16), index=True,
+                                                   doc="run id of the analysed simulation: the stem of its "
+                                                       "path results/sim/{solver}/{run_id}.h5")
     analysis: Mapped[str] = mapped_column(String, index=True)
     solver: Mapped[str] = mapped_column(String, index=True)
     source: Mapped[str | None] = mapped_column(String, index=True,

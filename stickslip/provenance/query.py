@@ -8,15 +8,20 @@ never change it, and returns a :class:`pandas.DataFrame`. Filters left at
 from pathlib import Path
 
 import pandas as pd
+import sqlalchemy.exc
 from sqlalchemy import select, text
 
 from ..h5io import FileFormatError
 from .database import Figure, Run, Simulation, SlipEvent, engine_for
 
-__all__ = ["DEFAULT_DATABASE", "runs", "events", "figures", "sql"]
+__all__ = ["DEFAULT_DATABASE", "QueryError", "runs", "events", "figures", "sql"]
 
 #: Where the workflow writes the database (relative to the workflow directory).
 DEFAULT_DATABASE = "results/stickslip.sqlite"
+
+
+class QueryError(ValueError):
+    """A query failed (bad SQL, or an attempt to write through the read-only connection)."""
 
 
 def _engine(database):
@@ -35,6 +40,9 @@ def _frame(database, statement):
     try:
         with engine.connect() as connection:
             frame = pd.read_sql(statement, connection)
+    except (pd.errors.DatabaseError, sqlalchemy.exc.DBAPIError) as error:
+        cause = getattr(error.__cause__, "orig", None) or error.__cause__ or error
+        raise QueryError(f"{database}: query failed: {cause}") from None
     finally:
         engine.dispose()
     for column in INTEGER_COLUMNS:
@@ -149,6 +157,11 @@ def sql(query, database=DEFAULT_DATABASE):
     Returns
     -------
     pandas.DataFrame
+
+    Raises
+    ------
+    QueryError
+        If the SQL is wrong or tries to write.
 
     Notes
     -----

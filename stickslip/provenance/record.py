@@ -237,9 +237,12 @@ def recording(record_file, outputs, **identity):
     Notes
     -----
     Nothing is written if the block raises, so a failed job leaves no record.
-    Inputs are hashed before the job starts (a missing input fails early).
+    Inputs are hashed before the job starts (a missing input fails early); the
+    outputs' directories are created.
     """
     recorder = Recorder(**identity)
+    for _, path in outputs:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
     start_clock, start = time.perf_counter(), _now()
     yield recorder
     wall = time.perf_counter() - start_clock

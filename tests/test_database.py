@@ -1,0 +1,114 @@
+"""The results database: ingest (idempotent, atomic, concurrent), schema, queries."""
+
+import json
+import multiprocessing
+import sqlite3
+
+import numpy as np
+import pytest
+
+from stickslip.h5io import FileFormatError, open_file, read_table
+from stickslip.provenance import ingest as ingest_module
+from stickslip.provenance import query
+from stickslip.provenance.database import SCHEMA_VERSION
+from stickslip.provenance.ingest import find_records, ingest
+from stickslip.provenance.record import read_record
+
+
+def _counts(database):
+    with sqlite3.connect(database) as connection:
+        return {table: connection.execute(f"SELECT COUNT(*) FROM {table}").fetchone()[0]
+                for table in ("runs", "artifacts", "simulations", "slip_events", "figures")}
+
+
+def test_ingest_fills_every_table_from_records(toy_results):
+    database = "results/stickslip.sqlite"
+    counts = ingest(database, toy_results)
+    assert counts["records"] == 5
+    table = _counts(database)
+    # 2 simulations + 2 analyses + 1 figure; artifacts: 2 + 2x2 + (4 inputs + 2 outputs)
+    assert table == {"runs": 5, "artifacts": 12, "simulations": 2, "slip_events": 8, "figures": 1}
+    runs = query.runs(database)
+    assert sorted(runs["kind"]) == ["analysis", "analysis", "figure", "solver", "solver"]
+    sims = query.runs(database, kind="solver")
+    assert sorted(sims["seed"]) == [1, 2]
+    # events: the slips of the table, one per slip, each equal to the file's values
+    run = query.runs(database, kind="solver", seed=1)["run_id"].iloc[0]
+    events = query.events(database, run_id=run)
+    with open_file(f"results/events/toy-slips/toy-spring-block/{run}.h5") as handle:
+        slips = read_table(handle, "slips")
+    np.testing.assert_array_equal(events["slip"].to_numpy(), slips["dR"].to_numpy())
+    np.testing.assert_array_equal(events["time"].to_numpy(), slips["t"].to_numpy())
+    assert set(events["seed"]) == {1} and set(events["interface"]) == {1}
+    assert set(events["source"]) == {"numerical"}  # the toy file is not in the lab time-series format
+    assert list(query.figures(database)["figure"]) == ["toy-force"]
+    assert query.sql("SELECT value FROM schema_info WHERE key = 'schema_version'", database).iloc[0, 0] == str(
+        SCHEMA_VERSION)
+
+
+def test_ingest_is_idempotent_and_rebuild_matches(toy_results):
+    database = "results/stickslip.sqlite"
+    ingest(database, toy_results)
+    first = _counts(database)
+    ingest(database, toy_results)
+    ingest(database, toy_results[:2])
+    assert _counts(database) == first
+    ingest(database, find_records("results"), rebuild=True)
+    assert _counts(database) == first
+    ingest(database, toy_results[:1], rebuild=True)  # a rebuild holds exactly its records
+    assert _counts(database)["runs"] == 1
+
+
+def test_an_interrupted_ingest_leaves_the_previous_database(toy_results, monkeypatch):
+    database = "results/stickslip.sqlite"
+    ingest(database, toy_results[:2])
+    before = _counts(database)
+
+    calls = []
+    original = ingest_module._ingest_record
+
+    def failing(session, record, record_file):
+        calls.append(record_file)
+        if len(calls) == 3:
+            raise KeyboardInterrupt  # e.g. Ctrl-C in the middle of the ingest
+        return original(session, record, record_file)
+
+    monkeypatch.setattr(ingest_module, "_ingest_record", failing)
+    with pytest.raises(KeyboardInterrupt):
+        ingest(database, toy_results)
+    assert _counts(database) == before
+    monkeypatch.setattr(ingest_module, "_ingest_record", original)
+    # a corrupted record: named, and the database is unchanged
+    toy_results[-1].write_text("{")
+    with pytest.raises(FileFormatError, match="toy-force.provenance.json: not a valid provenance record"):
+        ingest(database, toy_results)
+    assert _counts(database) == before
+    assert [p.name for p in toy_results[0].parents[2].iterdir() if p.name.endswith(".tmp")] == []
+
+
+def _ingest_one(args):
+    database, record = args
+    ingest(database, [record])
+
+
+def test_concurrent_ingests_lose_no_record(toy_results):
+    database = "results/stickslip.sqlite"
+    with multiprocessing.get_context("spawn").Pool(2) as pool:
+        pool.map(_ingest_one, [(database, str(r)) for r in toy_results * 2])
+    assert _counts(database)["runs"] == len(toy_results)
+    assert set(query.runs(database)["run_id"]) == {read_record(r)["run_id"] for r in toy_results}
+
+
+def test_queries_are_read_only_and_filter(toy_results):
+    database = "results/stickslip.sqlite"
+    ingest(database, toy_results)
+    with pytest.raises(query.QueryError, match="attempt to write a readonly database"):
+        query.sql("DELETE FROM runs", database)
+    assert _counts(database)["runs"] == 5
+    assert len(query.events(database, interface=2)) == 0
+    assert len(query.events(database, solver="toy-spring-block", seed=2)) == 4
+    assert len(query.runs(database, plugin="toy-slips")) == 2
+    params = json.loads(query.runs(database, kind="solver", seed=1)["params"].iloc[0])
+    assert params["slips"] == 4 and params["seed"] == 1
+    with pytest.raises(FileFormatError, match="no such database"):
+        query.runs("results/missing.sqlite")

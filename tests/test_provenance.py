@@ -1,0 +1,80 @@
+"""Provenance records and code hashes."""
+
+import hashlib
+import json
+import shutil
+
+import pytest
+
+from stickslip.h5io import FileFormatError
+from stickslip.provenance import code
+from stickslip.provenance.record import (REQUIRED_FIELDS, read_record, record_path, recording, sha256_file,
+                                         write_record)
+
+
+def test_code_hash_follows_package_imports():
+    sources = {p.relative_to(code.ROOT).as_posix() for p in code.module_sources("stickslip.cli.simulate")}
+    # direct (registry), through another package module (registry -> params), and the package inits
+    assert {"cli/simulate.py", "registry.py", "params.py", "numba_options.py", "__init__.py",
+            "cli/__init__.py"} <= sources
+    assert "figures/style.py" not in sources
+    assert len(code.code_hash("stickslip.h5io")) == 16
+
+
+def test_code_hash_changes_with_the_sources(tmp_path, monkeypatch):
+    package = tmp_path / "stickslip"
+    shutil.copytree(code.ROOT, package, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(code, "ROOT", package)
+    code.module_sources.cache_clear()
+    try:
+        before = code.code_hash("stickslip.cli.simulate")
+        unrelated = code.code_hash("stickslip.figures.style")
+        params = package / "params.py"
+        params.write_text(params.read_text() + "\n# edited\n")
+        assert code.code_hash("stickslip.cli.simulate") != before  # imported through registry
+        assert code.code_hash("stickslip.figures.style") == unrelated
+    finally:
+        code.module_sources.cache_clear()
+
+
+def test_record_fields_hashes_and_atomic_write(tmp_path):
+    source = tmp_path / "in.txt"
+    source.write_text("input")
+    output = tmp_path / "out.h5"
+    record_file = record_path(output)
+    assert record_file.name == "out.provenance.json"
+    with recording(record_file, [("output", output)], run_id="0" * 16, kind="solver", plugin="p",
+                   plugin_version="1", code_hash="c", params={"seed": 7, "x": 1.5}, threads=2,
+                   inputs=[("mesh", source)]):
+        output.write_bytes(b"result")
+    record = read_record(record_file)
+    assert set(REQUIRED_FIELDS) <= set(record)
+    assert record["seed"] == 7 and record["threads"] == 2 and record["params"] == {"seed": 7, "x": 1.5}
+    assert record["outputs"][0]["sha256"] == sha256_file(output)
+    assert record["inputs"][0]["sha256"] == hashlib.sha256(b"input").hexdigest()
+    assert record["outputs"][0]["bytes"] == 6
+    assert record["wall_time_s"] >= 0 and record["peak_memory_mib"] > 10
+    assert record["versions"]["numpy"] and record["versions"]["python"]
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no temporary left
+
+
+def test_a_failed_job_writes_no_record(tmp_path):
+    output = tmp_path / "out.h5"
+    with pytest.raises(RuntimeError):
+        with recording(record_path(output), [("output", output)], run_id="0" * 16, kind="solver", plugin="p",
+                       plugin_version="1", code_hash="c", params={}):
+            raise RuntimeError("solver failed")
+    assert not record_path(output).exists()
+
+
+def test_bad_records_are_reported_by_name(tmp_path):
+    broken = tmp_path / "a.provenance.json"
+    broken.write_text("{not json")
+    with pytest.raises(FileFormatError, match="a.provenance.json: not a valid provenance record"):
+        read_record(broken)
+    write_record(broken, {"schema_version": 1, "run_id": "x"})
+    with pytest.raises(FileFormatError, match="lacks kind, plugin"):
+        read_record(broken)
+    with pytest.raises(FileFormatError, match="no such provenance record"):
+        read_record(tmp_path / "missing.provenance.json")
+    assert json.loads(broken.read_text())["run_id"] == "x"
