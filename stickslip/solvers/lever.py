@@ -28,7 +28,7 @@ from ..experiment.timeseries import PROTOCOLS, write_timeseries
 from ..experiment.virtual import Apparatus, FrictionLaw, integrate, record, relative_positions
 from ..params import ParameterError, param, params_to_dict
 
-__all__ = ["LeverParams", "run", "simulate"]
+__all__ = ["LeverParams", "run", "simulate", "apparatus", "friction_law", "per_interface"]
 
 VERSION = "1"
 
