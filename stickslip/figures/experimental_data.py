@@ -80,14 +80,16 @@ def _sha256(path):
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def example_run(events_paths, lever_paths, *, n, protocol="stack"):
+def example_run(slips, lever_paths, *, n, protocol="stack"):
     """The first run (sorted by seed, then path) with ``n`` and ``protocol``: its time series and slips.
 
     Parameters
     ----------
-    events_paths, lever_paths : list of str or pathlib.Path
-        ``experiment-events`` files and time-series files; a table is matched to its time series by
-        the SHA-256 of the analysed file (attribute ``input_sha256``).
+    slips : pandas.DataFrame
+        :func:`load_slips` of the ``experiment-events`` files.
+    lever_paths : list of str or pathlib.Path
+        Time-series files; a table is matched to its time series by the SHA-256 of the analysed
+        file (attribute ``input_sha256`` of the table's file).
     n : int
     protocol : str
 
@@ -101,7 +103,6 @@ def example_run(events_paths, lever_paths, *, n, protocol="stack"):
     stickslip.h5io.FileFormatError
         If no such run, or no time series matching its table, is given.
     """
-    slips = load_slips(events_paths)
     runs = slips[(slips["n"] == n) & (slips["protocol"] == protocol)]
     if runs.empty:
         raise h5io.FileFormatError(f"no {EVENTS} file with n = {n} and protocol '{protocol}' among the inputs")

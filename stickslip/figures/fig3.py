@@ -50,8 +50,8 @@ def force_panel(ax, record, slips, t_range):
 @registry.register("figure", "fig3", VERSION, Fig3Params, inputs=(LEVER, EVENTS))
 def run(params, inputs, output):
     """Fig. 3: F(t) and R_i(t) excerpt, P(dF) for a = 1 and every n, dR_a measured vs from dF."""
-    record, run_slips = example_run(inputs[EVENTS], inputs[LEVER], n=params.n_example)
     slips = load_slips(inputs[EVENTS])
+    record, run_slips = example_run(slips, inputs[LEVER], n=params.n_example)
     fig = plt.figure(figsize=(8.0, 5.0), layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.5, 1.0))
     ax_F = fig.add_subplot(grid[0, 0])

@@ -1,0 +1,53 @@
+"""SI figure "Individual sliding": dR_a measured against dR_a from dF, P(dF) and P(dmu_a) of each
+interface driven alone."""
+
+import dataclasses
+
+import numpy as np
+from matplotlib.ticker import NullFormatter
+
+from .. import registry
+from ..params import param
+from .experimental_data import EVENTS, a_style, label_panels, load_slips, plot_density
+from .experimental_panels import LABELS, linear_edges, single_slips
+from .style import plt, save_figure
+
+VERSION = "1"
+
+
+@dataclasses.dataclass(frozen=True)
+class FigsIndividualParams:
+    """Binning of the distributions."""
+
+    bins: int = param(30, "bins of P(dF) and P(dmu_a), from 0 to the 99.5th percentile", minimum=2)
+
+
+@registry.register("figure", "figs-individual", VERSION, FigsIndividualParams, inputs=(EVENTS,))
+def run(params, inputs, output):
+    """SI individual sliding: dR_a vs dR_a(dF), P(dF) and P(dmu_a) per interface driven alone."""
+    alone = single_slips(load_slips(inputs[EVENTS]), "individual")
+    fig, axes = plt.subplots(1, 3, figsize=(10.0, 3.2), layout="constrained")
+    interfaces = sorted(alone["a"].unique())
+    for a in interfaces:
+        part = alone[alone["a"] == a]
+        axes[0].plot(part["dR_from_dF"], part["dR"], linestyle="none", markersize=3, alpha=0.6,
+                     markeredgewidth=0, **a_style(a))
+    if not alone.empty:
+        values = alone[["dR", "dR_from_dF"]].to_numpy(dtype=float)
+        limits = np.array([np.nanmin(values) / 1.1, np.nanmax(values) * 1.1])
+        axes[0].plot(limits, limits, color="black", linestyle="--", linewidth=0.8, label="$y = x$")
+        axes[0].set_xlim(limits)
+        axes[0].set_ylim(limits)
+    axes[0].set_xlabel(LABELS["dR_from_dF"])
+    axes[0].set_ylabel(r"$\Delta R_a$ measured (mm)")
+    for column, ax in zip(("dF", "dmu"), axes[1:]):
+        edges = linear_edges(alone[column], params.bins)
+        for a in interfaces:
+            plot_density(ax, alone.loc[alone["a"] == a, column], edges, **a_style(a))
+        ax.set_xlabel(LABELS[column])
+        ax.set_ylabel(f"$P$({LABELS[column].split(' (')[0]})")
+    for ax in axes:
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.legend(fontsize=6.5, frameon=False, title="$n = 1$ (individual)", title_fontsize=6.5)
+    label_panels(axes)
+    save_figure(fig, output)

@@ -1,0 +1,39 @@
+"""SI figure "Slip distributions": P(dmu_a), P(T_a) and P(B_a) for interfaces a = 1..4 and every n."""
+
+import dataclasses
+
+from .. import registry
+from ..params import param
+from .experimental_data import EVENTS, load_slips
+from .experimental_panels import distributions_by_n, linear_edges, log_edges, single_slips
+from .style import plt, save_figure
+
+VERSION = "1"
+
+
+@dataclasses.dataclass(frozen=True)
+class FigsSlipDistributionsParams:
+    """Interfaces shown and binning."""
+
+    interfaces: int = param(4, "interfaces a = 1..interfaces, one column each (the paper: 4)", minimum=1)
+    bins: int = param(25, "bins of P(dmu_a) and P(B_a)", minimum=2)
+    bins_per_decade: int = param(10, "logarithmic bins of T_a per decade", minimum=1)
+
+
+@registry.register("figure", "figs-slip-distributions", VERSION, FigsSlipDistributionsParams, inputs=(EVENTS,))
+def run(params, inputs, output):
+    """SI slip distributions: P(dmu_a), P(T_a), P(B_a) per interface a = 1..4, every n."""
+    slips = load_slips(inputs[EVENTS])
+    single = single_slips(slips)
+    fig, axes = plt.subplots(3, params.interfaces, figsize=(2.6 * params.interfaces, 7.2), layout="constrained",
+                             squeeze=False)
+    for column, a in enumerate(range(1, params.interfaces + 1)):
+        own = single[single["a"] == a]
+        distributions_by_n(axes[0, column], slips, a, "dmu", linear_edges(own["dmu"], params.bins))
+        distributions_by_n(axes[1, column], slips, a, "T", log_edges(own["T"], params.bins_per_decade),
+                           logarithmic=True)
+        distributions_by_n(axes[2, column], slips, a, "B_a", linear_edges(own["B_a"], params.bins))
+        for row, letter in enumerate("abc"):
+            axes[row, column].set_title(f"({letter}.{a})  $a = {a}$", loc="left", fontsize=9)
+        axes[0, column].legend(fontsize=6, frameon=False, loc="best")
+    save_figure(fig, output)
