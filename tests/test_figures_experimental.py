@@ -1,0 +1,76 @@
+"""Experimental figures: densities, run matching, and every figure drawn from a small virtual study."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stickslip import registry
+from stickslip.figures import experimental_data
+from stickslip.figures.experimental_panels import linear_edges, log_edges
+from stickslip.h5io import FileFormatError
+from stickslip.params import parse_params
+
+FIGURES = ("fig3", "fig4", "fig5", "fig6", "figs-individual", "figs-slip-distributions", "figs-aging-variations",
+           "figs-slow-slip")
+
+
+def test_density_is_normalised_on_linear_and_logarithmic_bins():
+    rng = np.random.default_rng(0)
+    values = rng.lognormal(3.0, 1.0, 5000)
+    for edges in (linear_edges(values, 40), log_edges(values, 10)):
+        centres, pdf = experimental_data.density(values, edges)
+        inside = np.count_nonzero((values >= edges[0]) & (values <= edges[-1])) / values.size
+        assert np.nansum(pdf * np.diff(edges)) == pytest.approx(inside)
+        assert np.all((centres > edges[:-1]) & (centres < edges[1:]))
+    # Logarithmic edges have geometric centres.
+    centres, _ = experimental_data.density([2.0, 20.0], np.array([1.0, 10.0, 100.0]))
+    np.testing.assert_allclose(centres, [np.sqrt(10.0), np.sqrt(1000.0)])
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """A small virtual study: stacks n = 1..5 and interfaces 1..4 driven alone, analysed."""
+    root = tmp_path_factory.mktemp("study")
+    solver, analysis = registry.get("solver", "lever"), registry.get("analysis", "experiment-events")
+    runs = [{"n": n, "seed": n} for n in range(1, 6)]
+    runs += [{"protocol": "individual", "a": a, "seed": 10 + a} for a in range(1, 5)]
+    inputs = {experimental_data.LEVER: [], experimental_data.EVENTS: []}
+    for index, values in enumerate(runs):
+        raw, events = root / f"raw{index}.h5", root / f"events{index}.h5"
+        solver.run(parse_params(solver.params, {**values, "duration": 2500.0}), raw, threads=1, inputs={})
+        analysis.run(parse_params(analysis.params, {}), raw, events)
+        inputs[experimental_data.LEVER].append(raw)
+        inputs[experimental_data.EVENTS].append(events)
+    return inputs
+
+
+def test_example_run_is_matched_by_content(study):
+    slips = experimental_data.load_slips(study[experimental_data.EVENTS])
+    assert set(slips["n"]) == {1, 2, 3, 4, 5} and set(slips["protocol"]) == {"stack", "individual"}
+    record, run_slips = experimental_data.example_run(slips, study[experimental_data.LEVER], n=4)
+    assert record.n == 4 and record.protocol == "stack"
+    assert set(run_slips["n"]) == {4} and run_slips["file"].nunique() == 1
+    with pytest.raises(FileFormatError, match="none of the solver:lever inputs"):
+        experimental_data.example_run(slips, study[experimental_data.LEVER][:3], n=4)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", FIGURES)
+def test_every_figure_is_drawn_reproducibly(study, tmp_path, name):
+    plugin = registry.get("figure", name)
+    inputs = {category: study[category] for category in plugin.inputs}
+    params = parse_params(plugin.params, {})
+    plugin.run(params, inputs, tmp_path / "a.pdf")
+    plugin.run(params, inputs, tmp_path / "b.pdf")
+    assert (tmp_path / "a.png").stat().st_size > 10_000
+    assert (tmp_path / "a.pdf").read_bytes() == (tmp_path / "b.pdf").read_bytes()
+
+
+def test_inputs_without_run_attributes_are_refused(tmp_path):
+    from stickslip.h5io import open_file, write_table
+
+    path = tmp_path / "other.h5"
+    with open_file(path, "w") as f:
+        write_table(f, "slips", pd.DataFrame({"a": [1]}))
+    with pytest.raises(FileFormatError, match="attribute 'n' is missing"):
+        experimental_data.load_slips([path])
