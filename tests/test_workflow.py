@@ -1,0 +1,202 @@
+"""The workflow machinery: study expansion, config errors, entry-point plugins, Snakemake runs.
+
+The Snakemake runs use the toy plugins of tests/toy_plugin (registered through entry points of
+an installed distribution), so they test the machinery independently of the real solvers; the
+smoke test (test_workflow_smoke.py) runs the real ci study.
+"""
+
+import copy
+import os
+import re
+import sqlite3
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import copy_workflow, python_path
+from stickslip import registry
+from stickslip.params import ParameterError, parse_params
+from stickslip.provenance.record import REQUIRED_FIELDS, read_record
+from stickslip.study import Study
+
+TOY_CONFIG = {
+    "threads": 1,
+    "solvers": {"toy-spring-block": [{"params": {"slips": 4}, "grid": {"seed": [1, 2, 3]}},
+                                     {"params": {"slips": 4, "seed": 1}, "grid": {}}]},
+    "analyses": {"toy-slips": None},
+    "figures": {"toy-force": {"width": 5.0}},
+}
+
+
+def test_entry_point_plugins_are_discovered(toy_plugins):
+    assert registry.get("solver", "toy-spring-block").module == "stickslip_toy"
+    assert registry.get("analysis", "toy-slips").inputs == ("toy-spring-block",)
+    assert "toy-force" in registry.available("figure")
+
+
+def test_toy_solver_slips_match_the_closed_form(toy_plugins):
+    import stickslip_toy as toy
+
+    params = parse_params(toy.BlockParams, {"seed": 3, "slips": 6})
+    t, x, F = toy.simulate(params)
+    moving = np.diff(x) > 0
+    starts = np.flatnonzero(moving & ~np.r_[False, moving[:-1]])
+    ends = np.flatnonzero(moving & ~np.r_[moving[1:], False]) + 1
+    expected = toy.slip_amplitude(toy.thresholds(params), params)
+    np.testing.assert_allclose(x[ends] - x[starts], expected, rtol=1e-5)
+    # the force at each slip onset is the contact's threshold
+    np.testing.assert_allclose(F[starts], toy.thresholds(params), rtol=1e-12)
+
+
+def test_study_expands_grids_and_resolves_inputs(toy_plugins):
+    study = Study(copy.deepcopy(TOY_CONFIG))
+    assert sorted(sim.params["seed"] for sim in study.simulations) == [1, 2, 3]  # the repeated run once
+    assert all(sim.params["slips"] == 4 and sim.params["k"] == 1.0 for sim in study.simulations)
+    assert len(study.analysis_jobs) == 3
+    figure = study.figures["toy-force"]
+    assert figure.params == {"width": 5.0}
+    assert figure.inputs["solver:toy-spring-block"] == sorted(sim.path for sim in study.simulations)
+    assert len(figure.inputs["analysis:toy-slips"]) == 3
+    assert len(study.records()) == 3 + 3 + 1
+    sim = study.simulations[0]
+    assert sim.path == f"results/sim/toy-spring-block/{sim.run_id}.h5"
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda c: c["solvers"]["toy-spring-block"][0]["grid"].update(seed=[1, "x"]),
+     r"config solvers.toy-spring-block\[0\]: parameter 'seed': expected an integer, got 'x'"),
+    (lambda c: c["solvers"]["toy-spring-block"][1]["params"].update(F_d=0.95),
+     r"config solvers.toy-spring-block\[1\]: parameter 'F_d': must be below"),
+    (lambda c: c["solvers"].update(nope=[]), r"config solvers.nope: unknown solver 'nope'"),
+    (lambda c: c["figures"].update({"toy-force": {"height": 1}}), r"config figures.toy-force: unknown parameter"),
+    (lambda c: c["solvers"].pop("toy-spring-block"), r"config analyses.toy-slips: it reads outputs"),
+])
+def test_study_errors_name_the_config_key(toy_plugins, change, message):
+    config = copy.deepcopy(TOY_CONFIG)
+    change(config)
+    with pytest.raises(ParameterError, match=message):
+        Study(config)
+
+
+# Snakemake in a subprocess ------------------------------------------------------------------------
+
+TOY_YAML = """\
+solvers:
+  toy-spring-block:
+    - params: {slips: 4}
+      grid: {seed: [1, 2, 3]}
+analyses:
+  toy-slips:
+figures:
+  toy-force: {width: 5.0}
+"""
+
+
+def snakemake(directory, *args, distribution=None, check=True):
+    env = dict(os.environ, PYTHONPATH=python_path(*([distribution] if distribution else [])))
+    result = subprocess.run(["snakemake", *args], cwd=directory, env=env, capture_output=True, text=True,
+                            timeout=600)
+    if check and result.returncode != 0:
+        raise AssertionError(f"snakemake {' '.join(args)} failed:\n{result.stdout}\n{result.stderr}")
+    return result
+
+
+def planned_jobs(output):
+    """Job counts from the 'Job stats' table of a dry run."""
+    table = output.split("Job stats:", 1)[1].split("total", 1)[0]
+    return dict((name, int(count)) for name, count in re.findall(r"^(\S+)\s+(\d+)$", table, re.M))
+
+
+def test_bad_config_value_stops_before_any_job(tmp_path, toy_distribution):
+    copy_workflow(tmp_path)
+    (tmp_path / "bad.yaml").write_text(TOY_YAML.replace("slips: 4", "slips: -4"))
+    result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
+    assert result.returncode != 0
+    text = result.stdout + result.stderr
+    assert "config key solvers.toy-spring-block[0].params: ValidationError: -4 is less than the minimum of 1" in text
+    (tmp_path / "bad.yaml").write_text(TOY_YAML + "thread: 2\n")
+    result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
+    assert result.returncode != 0
+    assert "Additional properties are not allowed ('thread' was unexpected)" in result.stdout + result.stderr
+    assert not (tmp_path / "results").exists() and not (tmp_path / "logs").exists()
+
+
+@pytest.fixture(scope="module")
+def toy_workflow(tmp_path_factory, toy_distribution):
+    """The toy study run once with `snakemake --cores 2`; returns (directory, first run's output)."""
+    directory = copy_workflow(tmp_path_factory.mktemp("toy-workflow"))
+    (directory / "toy.yaml").write_text(TOY_YAML)
+    result = snakemake(directory, "--cores", "2", "--configfile", "toy.yaml", distribution=toy_distribution)
+    return directory, result.stdout + result.stderr
+
+
+@pytest.mark.slow
+def test_toy_workflow_outputs_records_and_database(toy_workflow):
+    directory, _ = toy_workflow
+    results = directory / "results"
+    sims = sorted((results / "sim" / "toy-spring-block").glob("*.h5"))
+    events = sorted((results / "events" / "toy-slips" / "toy-spring-block").glob("*.h5"))
+    assert len(sims) == 3 and len(events) == 3
+    assert (results / "figures" / "toy-force.pdf").stat().st_size > 1000
+    assert (results / "figures" / "toy-force.png").stat().st_size > 1000
+    records = sorted(results.rglob("*.provenance.json"))
+    assert len(records) == 7
+    for path in records:
+        record = read_record(path)
+        assert all(record[field] is not None for field in REQUIRED_FIELDS if field not in ("seed", "git_commit",
+                                                                                          "git_dirty"))
+        for entry in record["outputs"]:
+            assert (directory / entry["path"]).is_file()
+    sim_record = read_record(sims[0].with_suffix(".provenance.json"))
+    with h5py.File(sims[0]) as file:
+        assert file.attrs["seed"] == sim_record["seed"] == sim_record["params"]["seed"]
+    assert sim_record["run_id"] == sims[0].stem and sim_record["threads"] == 1
+    # the database holds every record (two jobs ran at a time: none lost) and every slip
+    with sqlite3.connect(results / "stickslip.sqlite") as connection:
+        run_ids = {row[0] for row in connection.execute("SELECT run_id FROM runs")}
+        n_events = connection.execute("SELECT COUNT(*) FROM slip_events").fetchone()[0]
+    assert run_ids == {read_record(path)["run_id"] for path in records}
+    assert n_events == 3 * 4
+    assert (directory / "logs" / "benchmarks" / "sim" / "toy-spring-block" / f"{sims[0].stem}.tsv").is_file()
+    assert (directory / "logs" / "figures" / "toy-force.log").is_file()
+
+
+@pytest.mark.slow
+def test_toy_workflow_second_run_and_single_figure(toy_workflow, toy_distribution):
+    directory, _ = toy_workflow
+    again = snakemake(directory, "-n", "--cores", "2", "--configfile", "toy.yaml", distribution=toy_distribution)
+    assert "Nothing to be done" in again.stdout + again.stderr
+    # the README's command (the target first: --forcerun takes every name after it)
+    forced = snakemake(directory, "results/figures/toy-force.pdf", "-n", "--configfile", "toy.yaml",
+                       "--forcerun", "figure_toy_force", distribution=toy_distribution)
+    assert planned_jobs(forced.stdout + forced.stderr) == {"figure_toy_force": 1}
+
+
+@pytest.mark.slow
+def test_toy_workflow_lint_and_report(toy_workflow, toy_distribution):
+    directory, _ = toy_workflow
+    lint = snakemake(directory, "--lint", "--configfile", "toy.yaml", distribution=toy_distribution)
+    assert "Congratulations, your workflow is in a good condition!" in lint.stdout + lint.stderr
+    snakemake(directory, "--configfile", "toy.yaml", "--report", "report.zip", distribution=toy_distribution)
+    assert (directory / "report.zip").stat().st_size > 10000
+
+
+@pytest.mark.slow
+def test_corrupted_input_gives_a_clear_error(toy_workflow, toy_distribution, tmp_path):
+    directory, _ = toy_workflow
+    broken = copy_workflow(tmp_path)
+    (broken / "toy.yaml").write_text(TOY_YAML)
+    sim = sorted((directory / "results" / "sim" / "toy-spring-block").glob("*.h5"))[0]
+    target = broken / "results" / "sim" / "toy-spring-block" / sim.name
+    target.parent.mkdir(parents=True)
+    target.write_bytes(sim.read_bytes()[:200])  # a truncated file
+    (broken / "results/sim/toy-spring-block" / f"{sim.stem}.provenance.json").write_text("{}")
+    event = f"results/events/toy-slips/toy-spring-block/{sim.stem}.h5"
+    result = snakemake(broken, event, "--cores", "1", "--configfile", "toy.yaml", "--allowed-rules", "events",
+                       distribution=toy_distribution, check=False)
+    assert result.returncode != 0
+    assert f"results/sim/toy-spring-block/{sim.name}: not a readable HDF5 file" in result.stdout + result.stderr
+    assert not (broken / event).exists()
