@@ -15,7 +15,7 @@ from .. import h5io
 from ..experiment.timeseries import read_timeseries
 from .style import N_MARKERS, interface_color, n_color
 
-__all__ = ["EVENTS", "LEVER", "load_slips", "load_interfaces", "example_run", "density", "plot_density",
+__all__ = ["EVENTS", "LEVER", "load_slips", "load_interfaces", "example_run", "excerpt", "density", "plot_density",
            "n_style", "individual_style", "a_style", "label_panels"]
 
 #: Input categories of the experimental figures.
@@ -116,6 +116,13 @@ def example_run(slips, lever_paths, *, n, protocol="stack"):
         if same and _sha256(path) == digest:
             return read_timeseries(path), runs[runs["file"] == chosen]
     raise h5io.FileFormatError(f"{chosen}: none of the {LEVER} inputs is the time series it was made from")
+
+
+def excerpt(record, t_from, duration):
+    """Time range ``(t_0, t_1)`` [s] of length ``duration`` from ``t_from``, moved back to end with the
+    record if it is shorter."""
+    end = min(t_from + duration, record.t_x[-1])
+    return (max(record.t_x[0], end - duration), end)
 
 
 def density(values, edges):

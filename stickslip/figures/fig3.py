@@ -8,7 +8,7 @@ from matplotlib.ticker import NullFormatter
 
 from .. import registry
 from ..params import param
-from .experimental_data import EVENTS, LEVER, a_style, example_run, label_panels, load_slips
+from .experimental_data import EVENTS, LEVER, a_style, example_run, excerpt, label_panels, load_slips
 from .experimental_panels import LABELS, distributions_by_n, linear_edges, positions_panel, single_slips
 from .style import interface_color, plt, save_figure
 
@@ -23,11 +23,6 @@ class Fig3Params:
     t_from: float = param(5400.0, "start t_0 of the excerpt (the run's last stretch if it is shorter)", unit="s",
                           minimum=0)
     duration: float = param(400.0, "length of the excerpt", unit="s", exclusive_minimum=0)
-
-
-def _excerpt(record, t_from, duration):
-    end = min(t_from + duration, record.t_x[-1])
-    return (max(record.t_x[0], end - duration), end)
 
 
 def force_panel(ax, record, slips, t_range):
@@ -58,7 +53,7 @@ def run(params, inputs, output):
     ax_R = fig.add_subplot(grid[1, 0], sharex=ax_F)
     ax_dF = fig.add_subplot(grid[0, 1])
     ax_dR = fig.add_subplot(grid[1, 1])
-    t_range = _excerpt(record, params.t_from, params.duration)
+    t_range = excerpt(record, params.t_from, params.duration)
     force_panel(ax_F, record, run_slips, t_range)
     ax_F.text(0.98, 0.97, f"$n = {record.n}$", transform=ax_F.transAxes, ha="right", va="top", fontsize=9)
     ax_F.tick_params(labelbottom=False)
