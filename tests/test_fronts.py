@@ -105,6 +105,12 @@ def test_front_tables_rerun_the_steady_multi_slips(tmp_path):
     assert list(failures.columns) == ["increment", "a", "block", "t", "direction"]
     assert len(failures) == 2 * 2 * 2 * N
     assert failures.groupby("increment")["t"].apply(lambda t: t.is_monotonic_increasing).all()
+    # runs with another number of interfaces are not re-run
+    asked.clear()
+    params = parse_params(fronts.FrontParams, {"interfaces": 3})
+    failures, table = fronts.front_tables(classified, rerun, N=N, h=H_BLOCK, c_s=C_S, spacing=SPACING, params=params)
+    assert asked == [] and failures.empty and table.empty
+    assert failures.dtypes["t"] == np.float64 and table.dtypes["tau"] == np.float64
 
 
 def test_fit_window_must_not_be_empty():

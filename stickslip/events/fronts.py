@@ -203,6 +203,8 @@ class FrontParams:
     """Parameters of the front-dynamics analysis."""
 
     max_events: int = param(10, "steady-state multi-slip increments re-run per fem run (the first ones)", minimum=1)
+    interfaces: int = param(2, "re-run events only in runs with this many interfaces (the paper: 2; 0: every "
+                               "run); the output of other runs has empty tables", minimum=0)
     fit_from: float = param(0.3, "front fit: smallest distance from the nucleation block, fraction of half the "
                                  "interface length", minimum=0.0, maximum=1.0)
     fit_to: float = param(0.9, "front fit: largest distance from the nucleation block, fraction of half the "
@@ -227,6 +229,8 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
     N, h, c_s, spacing
         See :func:`analyse_event`.
     params : FrontParams
+        ``max_events``, ``interfaces`` (runs with another number of interfaces give empty
+        tables), ``fit_from``, ``fit_to``.
 
     Returns
     -------
@@ -235,7 +239,9 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
         interface, block) and ``fronts`` (columns of :data:`FRONT_DTYPES`, one row per event).
     """
     failures, fronts = [], []
-    for increment in multi_slip_increments(classified, params.max_events):
+    n = len(extraction.interfaces_in(classified))
+    chosen = multi_slip_increments(classified, params.max_events) if params.interfaces in (0, n) else []
+    for increment in chosen:
         events = rerun(int(increment))
         _check_failures(events, f"re-run of increment {increment}")
         events = events[list(FAILURE_COLUMNS)].sort_values(["t", "a", "block"], kind="stable")
