@@ -10,10 +10,12 @@ This module imports nothing that imports numba: :func:`prepare_environment`
 must set the numba variables before the first plugin is loaded.
 """
 
+import atexit
 import contextlib
 import hashlib
 import json
 import os
+import shutil
 import sys
 import tempfile
 import traceback
@@ -40,8 +42,9 @@ def prepare_environment(threads, numba_cache=""):
         The rule's threads: ``NUMBA_NUM_THREADS`` (numba's thread pool size).
     numba_cache : {"", "job"}
         ``"job"``: compile into a fresh cache directory of this job under
-        ``$TMPDIR`` (``NUMBA_CACHE_DIR``), as on a cluster where many jobs share
-        one file system; ``""``: numba's default cache beside the sources.
+        ``$TMPDIR`` (``NUMBA_CACHE_DIR``, removed when the process ends), as on a
+        cluster where many jobs share one file system; ``""``: numba's default
+        cache beside the sources.
 
     Returns
     -------
@@ -56,6 +59,7 @@ def prepare_environment(threads, numba_cache=""):
             raise RuntimeError("numba_cache='job' needs prepare_environment before numba is imported")
         cache = tempfile.mkdtemp(prefix="stickslip-numba-")
         os.environ["NUMBA_CACHE_DIR"] = cache
+        atexit.register(shutil.rmtree, cache, ignore_errors=True)
         return cache
     if numba_cache:
         raise ValueError(f"numba_cache must be '' or 'job', got {numba_cache!r}")
@@ -100,7 +104,7 @@ def _load(kind, name, params_json):
     return plugin, params
 
 
-def run_mesh(params_json, output, record, log):
+def run_mesh(params_json, output, record, log, *, numba_cache=""):
     """Write one mesh file.
 
     Parameters
@@ -109,8 +113,10 @@ def run_mesh(params_json, output, record, log):
         :class:`stickslip.mesh.MeshParams` values as JSON.
     output, record, log : str or pathlib.Path
         Mesh file (HDF5), its provenance record, the log.
+    numba_cache : {"", "job"}
+        See :func:`prepare_environment`.
     """
-    prepare_environment(1)
+    prepare_environment(1, numba_cache)
     with _logged(log):
         from . import mesh
 
@@ -157,7 +163,7 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
             plugin.run(params, Path(output), threads=used, inputs={k: Path(v) for k, v in inputs.items()})
 
 
-def run_analysis(analysis, params_json, input, output, record, log):
+def run_analysis(analysis, params_json, input, output, record, log, *, numba_cache=""):
     """Run one analysis on one simulation output.
 
     Parameters
@@ -170,8 +176,10 @@ def run_analysis(analysis, params_json, input, output, record, log):
         The simulation file.
     output, record, log : str or pathlib.Path
         Table file (HDF5), its provenance record, the log.
+    numba_cache : {"", "job"}
+        See :func:`prepare_environment`.
     """
-    prepare_environment(1)
+    prepare_environment(1, numba_cache)
     with _logged(log):
         plugin, params = _load("analysis", analysis, params_json)
         _check_hdf5("simulation", input)
@@ -183,7 +191,7 @@ def run_analysis(analysis, params_json, input, output, record, log):
             plugin.run(params, Path(input), Path(output))
 
 
-def run_figure(figure, params_json, inputs_json, output, record, log):
+def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_cache=""):
     """Draw one figure.
 
     Parameters
@@ -196,8 +204,10 @@ def run_figure(figure, params_json, inputs_json, output, record, log):
         JSON object: input category -> list of paths.
     output, record, log : str or pathlib.Path
         The PDF (the PNG goes beside it), the provenance record, the log.
+    numba_cache : {"", "job"}
+        See :func:`prepare_environment`.
     """
-    prepare_environment(1)
+    prepare_environment(1, numba_cache)
     with _logged(log):
         plugin, params = _load("figure", figure, params_json)
         inputs = json.loads(inputs_json)

@@ -10,6 +10,7 @@ import os
 import re
 import sqlite3
 import subprocess
+import sys
 from pathlib import Path
 
 import h5py
@@ -200,3 +201,15 @@ def test_corrupted_input_gives_a_clear_error(toy_workflow, toy_distribution, tmp
     assert result.returncode != 0
     assert f"results/sim/toy-spring-block/{sim.name}: not a readable HDF5 file" in result.stdout + result.stderr
     assert not (broken / event).exists()
+
+
+def test_job_environment_reaches_numba(tmp_path):
+    code = ("from stickslip.workflow_api import prepare_environment\n"
+            "cache = prepare_environment(2, 'job')\n"
+            "import numba\n"
+            "print(numba.config.NUMBA_NUM_THREADS, numba.config.CACHE_DIR == cache, cache)\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                            env=dict(os.environ, TMPDIR=str(tmp_path)), timeout=120)
+    threads, same, cache = result.stdout.split()
+    assert threads == "2" and same == "True" and cache.startswith(str(tmp_path))
+    assert not Path(cache).exists()  # removed when the job ends

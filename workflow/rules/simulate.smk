@@ -12,8 +12,6 @@ rule simulate:
     benchmark:
         "logs/benchmarks/sim/{solver}/{run_id}.tsv"
     threads: STUDY.threads
-    resources:
-        numba_cache="",
     params:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
         code=lambda wildcards: Study.code("solver", wildcards.solver),

@@ -2,4 +2,5 @@
 
 from stickslip.workflow_api import run_mesh
 
-run_mesh(snakemake.params.params, snakemake.output.h5, snakemake.output.record, snakemake.log[0])
+run_mesh(snakemake.params.params, snakemake.output.h5, snakemake.output.record, snakemake.log[0],
+         numba_cache=snakemake.resources.get("numba_cache", ""))
