@@ -19,9 +19,10 @@ POSITION_NOISE = 0.002  # lever default [mm] per slab
 FORCE_NOISE = 0.01  # lever default [N]
 # dR: difference of two 5-frame means of R = x_a - x_{a-1}: sigma = sqrt(2) * sqrt(2/5) * POSITION_NOISE.
 DR_SIGMA = 2.0 / np.sqrt(5.0) * POSITION_NOISE
-# dF: two 2 s windows of 100 samples and a common slope, extrapolated over ~4 s (detection.force_drop):
-# sigma^2 = FORCE_NOISE^2 (2/100 + 4^2 / (2 * 100 * 2^2 / 12)) -> ~0.5 FORCE_NOISE.
-DF_SIGMA = 0.5 * FORCE_NOISE
+# dF: two lines fitted on 1 s windows of 50 samples, each evaluated ~0.6 s from its window's centre
+# (detection.force_drop): sigma^2 = 2 FORCE_NOISE^2 (1/50 + 0.6^2 / (50 / 12)) -> 0.5 FORCE_NOISE, 0.7 with
+# the jitter of the located drop (test_experiment_analysis_detection).
+DF_SIGMA = 0.7 * FORCE_NOISE
 
 
 def _simulate(tmp_path, name, **values):

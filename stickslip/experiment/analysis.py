@@ -31,7 +31,7 @@ from .timeseries import read_timeseries
 
 __all__ = ["ExperimentEventsParams", "analyse_record", "run", "VERSION"]
 
-VERSION = "1"
+VERSION = "2"
 
 SLIP_COLUMNS = ["event", "t", "a", "n", "protocol", "multi", "t_start", "t_end", "dF", "dmu", "T", "dR",
                 "dR_from_dF", "B_a", "drift", "slow_slip_before"]
@@ -47,7 +47,7 @@ class ExperimentEventsParams:
                                 unit="frames", minimum=1)
     min_frames: int = param(detection.MIN_FRAMES, "minimum number of consecutive fast frames of a slip",
                             unit="frames", minimum=1)
-    force_window: float = param(2.0, "length of the force fits before and after a slip", unit="s",
+    force_window: float = param(1.0, "length of the force fits before and after a force drop", unit="s",
                                 exclusive_minimum=0)
     t_exclude: float = param(300.0, "initial transient excluded from the tables (from the first frame)",
                              unit="s", minimum=0)
