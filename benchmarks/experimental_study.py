@@ -24,8 +24,8 @@ from stickslip.experiment.aging import fit_aging, spread_of_aging_rate
 from stickslip.figures.experimental_data import EVENTS, LEVER, load_interfaces, load_slips
 from stickslip.params import parse_params
 
-FIGURES = ("fig3", "fig4", "fig5", "fig6", "figs-individual", "figs-slip-distributions", "figs-aging-variations",
-           "figs-slow-slip")
+FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distributions", "figS-aging-variations",
+           "figS-slow-slip")
 
 
 def _simulate_and_analyse(job):

@@ -10,8 +10,8 @@ from stickslip.figures.experimental_panels import linear_edges, log_edges
 from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
 
-FIGURES = ("fig3", "fig4", "fig5", "fig6", "figs-individual", "figs-slip-distributions", "figs-aging-variations",
-           "figs-slow-slip")
+FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distributions", "figS-aging-variations",
+           "figS-slow-slip")
 
 
 def test_density_is_normalised_on_linear_and_logarithmic_bins():

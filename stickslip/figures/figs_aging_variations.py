@@ -20,7 +20,7 @@ class FigsAgingVariationsParams:
     t0: float = param(1.0, "time scale T0 of the aging law", unit="s", exclusive_minimum=0)
 
 
-@registry.register("figure", "figs-aging-variations", VERSION, FigsAgingVariationsParams, inputs=(EVENTS,))
+@registry.register("figure", "figS-aging-variations", VERSION, FigsAgingVariationsParams, inputs=(EVENTS,))
 def run(params, inputs, output):
     """SI aging variations: dmu_a(T_a) by interface, by n, with individual slips, without slow slip."""
     slips = load_slips(inputs[EVENTS])

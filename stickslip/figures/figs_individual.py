@@ -22,7 +22,7 @@ class FigsIndividualParams:
     bins: int = param(30, "bins of P(dF) and P(dmu_a), from 0 to the 99.5th percentile", minimum=2)
 
 
-@registry.register("figure", "figs-individual", VERSION, FigsIndividualParams, inputs=(EVENTS,))
+@registry.register("figure", "figS-individual", VERSION, FigsIndividualParams, inputs=(EVENTS,))
 def run(params, inputs, output):
     """SI individual sliding: dR_a vs dR_a(dF), P(dF) and P(dmu_a) per interface driven alone."""
     alone = single_slips(load_slips(inputs[EVENTS]), "individual")

@@ -20,7 +20,7 @@ class FigsSlipDistributionsParams:
     bins_per_decade: int = param(10, "logarithmic bins of T_a per decade", minimum=1)
 
 
-@registry.register("figure", "figs-slip-distributions", VERSION, FigsSlipDistributionsParams, inputs=(EVENTS,))
+@registry.register("figure", "figS-slip-distributions", VERSION, FigsSlipDistributionsParams, inputs=(EVENTS,))
 def run(params, inputs, output):
     """SI slip distributions: P(dmu_a), P(T_a), P(B_a) per interface a = 1..4, every n."""
     slips = load_slips(inputs[EVENTS])

@@ -33,7 +33,7 @@ def _slip_frames(slips, n_frames, a):
     return inside
 
 
-@registry.register("figure", "figs-slow-slip", VERSION, FigsSlowSlipParams, inputs=(LEVER, EVENTS))
+@registry.register("figure", "figS-slow-slip", VERSION, FigsSlowSlipParams, inputs=(LEVER, EVENTS))
 def run(params, inputs, output):
     """SI slow slip: R_i(t) with detected slip frames, smoothed velocities and threshold, R_slow vs n."""
     record, _ = example_run(load_slips(inputs[EVENTS]), inputs[LEVER], n=params.n_example)
