@@ -123,7 +123,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache=""):
         params = parse_params(mesh.MeshParams, json.loads(params_json), owner="mesh")
         as_dict = params_to_dict(params)
         with recording(record, [("output", output)], run_id=mesh.mesh_id(params), kind="mesh", plugin="mesh",
-                       plugin_version=code_hash(mesh.write_mesh.__module__),
+                       plugin_version=str(mesh.MESH_FORMAT),
                        code_hash=code_hash(mesh.write_mesh.__module__), params=as_dict):
             print(f"mesh {json.dumps(as_dict, sort_keys=True)} -> {output}")
             mesh.write_mesh(params, Path(output))
