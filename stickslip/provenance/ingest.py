@@ -41,9 +41,10 @@ EVENT_TABLES = ("slip_interfaces", "slips")
 EVENT_COLUMNS = {"event": "event", "a": "interface", "dR": "slip", "dmu": "dmu", "t": "time",
                  "increment": "increment", "multi": "multi"}
 
-#: Column of ``simulations`` -> parameter (or root attribute of the simulation file) it comes from.
-SIMULATION_COLUMNS = {"protocol": "protocol", "n": "n", "a": "a", "plates": "plates", "blocks": "N",
-                      "k_drive": "k_drive", "regime": "regime", "seed": "seed"}
+#: Column of ``simulations`` -> names it comes from, first found: a parameter of the run, else a
+#: root attribute of the simulation file (fem runs have ``plates``; their files say ``n_interfaces``).
+SIMULATION_COLUMNS = {"protocol": ("protocol",), "n": ("n", "n_interfaces"), "a": ("a",), "plates": ("plates",),
+                      "blocks": ("N",), "k_drive": ("k_drive",), "regime": ("regime",), "seed": ("seed",)}
 
 #: An event's source is its simulation's (known once both records are in).
 SOURCE_FROM_SIMULATIONS = ("UPDATE slip_events SET source = (SELECT s.source FROM simulations AS s "
@@ -113,8 +114,9 @@ def _simulation_row(record, record_file):
         attrs = {key: _python(value) for key, value in handle.attrs.items()}
         source = "experimental" if "t_F" in handle else "numerical"
     row = {"run_id": record["run_id"], "solver": record["plugin"], "path": path, "source": source}
-    for column, name in SIMULATION_COLUMNS.items():
-        value = record["params"].get(name, attrs.get(name))
+    for column, names in SIMULATION_COLUMNS.items():
+        found = [source[name] for name in names for source in (record["params"], attrs) if name in source]
+        value = found[0] if found else None
         row[column] = value.decode() if isinstance(value, bytes) else value
     return row
 
