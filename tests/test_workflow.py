@@ -217,3 +217,28 @@ def test_job_environment_reaches_numba(tmp_path):
     threads, same, cache = result.stdout.split()
     assert threads == "2" and same == "True" and cache.startswith(str(tmp_path))
     assert not Path(cache).exists()  # removed when the job ends
+
+
+def test_solvers_that_read_a_mesh_share_one_mesh_job():
+    import dataclasses
+
+    from stickslip import mesh
+    from stickslip.params import param
+
+    @dataclasses.dataclass(frozen=True)
+    class MeshedParams:
+        N: int = param(9, "blocks per interface")
+        plates: int = param(3, "plates")
+        seed: int = param(0, "seed")
+
+    def solve(params, output, *, threads, inputs):
+        """Test solver reading a mesh."""
+
+    registry.register("solver", "test-meshed", "1", MeshedParams, inputs=("mesh",))(solve)
+    study = Study({"solvers": {"test-meshed": [{"params": {}, "grid": {"seed": [1, 2]}},
+                                               {"params": {"N": 27}, "grid": {}}]}})
+    expected = {mesh.mesh_id(parse_params(mesh.MeshParams, {"N": N, "plates": 3})): N for N in (9, 27)}
+    assert {key: value["N"] for key, value in study.meshes.items()} == expected
+    inputs = [study.solver_inputs(sim.solver, sim.run_id)["mesh"] for sim in study.simulations]
+    assert sorted(set(inputs)) == sorted(f"results/mesh/{key}.h5" for key in expected)
+    assert len(study.records()) == 2 + 3
