@@ -26,7 +26,7 @@ from pathlib import Path
 from ..h5io import FileFormatError, atomic_output
 
 __all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "sha256_file", "file_entry", "git_state",
-           "library_versions", "write_record", "read_record", "Recorder", "recording"]
+           "library_versions", "peak_memory_mib", "write_record", "read_record", "recording"]
 
 #: Version of the record layout; bump when fields change meaning.
 SCHEMA_VERSION = 1
@@ -196,24 +196,16 @@ def read_record(path):
     return record
 
 
-class Recorder:
-    """Collects what a job did; :func:`recording` creates one and writes its record.
-
-    Attributes
-    ----------
-    record : dict
-        The record being filled; ``outputs`` are added on success.
-    """
-
-    def __init__(self, *, run_id, kind, plugin, plugin_version, code_hash, params, threads=1, inputs=()):
-        commit, dirty = git_state()
-        self.record = {
-            "schema_version": SCHEMA_VERSION, "run_id": run_id, "kind": kind, "plugin": plugin,
-            "plugin_version": plugin_version, "code_hash": code_hash, "package_version": _package_version(),
-            "git_commit": commit, "git_dirty": dirty, "params": params, "seed": params.get("seed"),
-            "threads": threads, "versions": library_versions(), "host": socket.gethostname(),
-            "inputs": [file_entry(role, path) for role, path in inputs],
-        }
+def _job_record(*, run_id, kind, plugin, plugin_version, code_hash, params, threads=1, inputs=()):
+    """The part of a record known before the job runs (inputs are hashed now)."""
+    commit, dirty = git_state()
+    return {
+        "schema_version": SCHEMA_VERSION, "run_id": run_id, "kind": kind, "plugin": plugin,
+        "plugin_version": plugin_version, "code_hash": code_hash, "package_version": _package_version(),
+        "git_commit": commit, "git_dirty": dirty, "params": params, "seed": params.get("seed"),
+        "threads": threads, "versions": library_versions(), "host": socket.gethostname(),
+        "inputs": [file_entry(role, path) for role, path in inputs],
+    }
 
 
 @contextmanager
@@ -227,12 +219,14 @@ def recording(record_file, outputs, **identity):
     outputs : Sequence[tuple[str, str | pathlib.Path]]
         ``(role, path)`` of each file the job writes; hashed after the job.
     **identity
-        Keyword arguments of :class:`Recorder` (run_id, kind, plugin, ...).
+        ``run_id``, ``kind``, ``plugin``, ``plugin_version``, ``code_hash``,
+        ``params`` (dict), and optionally ``threads`` (int) and ``inputs``
+        (sequence of ``(role, path)``).
 
     Yields
     ------
-    Recorder
-        Its ``record`` may be extended by the job before the block ends.
+    dict
+        The record; the job may add fields before the block ends.
 
     Notes
     -----
@@ -240,15 +234,15 @@ def recording(record_file, outputs, **identity):
     Inputs are hashed before the job starts (a missing input fails early); the
     outputs' directories are created.
     """
-    recorder = Recorder(**identity)
+    record = _job_record(**identity)
     for _, path in outputs:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
     start_clock, start = time.perf_counter(), _now()
-    yield recorder
+    yield record
     wall = time.perf_counter() - start_clock
-    recorder.record.update({
+    record.update({
         "start": start, "end": _now(), "wall_time_s": round(wall, 6),
         "peak_memory_mib": round(peak_memory_mib(), 3),
         "outputs": [file_entry(role, path) for role, path in outputs],
     })
-    write_record(record_file, recorder.record)
+    write_record(record_file, record)
