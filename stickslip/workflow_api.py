@@ -98,6 +98,13 @@ def _derived_run_id(plugin, params, input_files):
     return digest.hexdigest()[:16]
 
 
+def _plugin_recording(record, outputs, plugin, params, run_id, **extra):
+    """:func:`recording` of a plugin run: identity, version and code hash from the plugin."""
+    return recording(record, outputs, run_id=run_id, kind=plugin.kind, plugin=plugin.name,
+                     plugin_version=plugin.version, code_hash=code_hash(plugin.module),
+                     params=params_to_dict(params), **extra)
+
+
 def _load(kind, name, params_json):
     plugin = registry.get(kind, name)
     params = parse_params(plugin.params, json.loads(params_json), owner=f"{kind} '{name}'")
@@ -155,11 +162,9 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         for role, path in inputs.items():
             _check_hdf5(role, path)
         used = set_num_threads(threads)
-        as_dict = params_to_dict(params)
-        with recording(record, [("output", output)], run_id=registry.run_id(plugin, params), kind="solver",
-                       plugin=plugin.name, plugin_version=plugin.version, code_hash=code_hash(plugin.module),
-                       params=as_dict, threads=used, inputs=sorted(inputs.items())):
-            print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(as_dict, sort_keys=True)}")
+        with _plugin_recording(record, [("output", output)], plugin, params, registry.run_id(plugin, params),
+                               threads=used, inputs=sorted(inputs.items())) as job:
+            print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(job['params'])}")
             plugin.run(params, Path(output), threads=used, inputs={k: Path(v) for k, v in inputs.items()})
 
 
@@ -184,9 +189,8 @@ def run_analysis(analysis, params_json, input, output, record, log, *, numba_cac
         plugin, params = _load("analysis", analysis, params_json)
         _check_hdf5("simulation", input)
         role = f"solver:{Path(input).parent.name}"
-        with recording(record, [("output", output)], run_id=_derived_run_id(plugin, params, [input]),
-                       kind="analysis", plugin=plugin.name, plugin_version=plugin.version,
-                       code_hash=code_hash(plugin.module), params=params_to_dict(params), inputs=[(role, input)]):
+        with _plugin_recording(record, [("output", output)], plugin, params,
+                               _derived_run_id(plugin, params, [input]), inputs=[(role, input)]):
             print(f"analysis {plugin.name} {plugin.version} on {input}")
             plugin.run(params, Path(input), Path(output))
 
@@ -216,9 +220,8 @@ def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_c
             _check_hdf5(role, path)
         output = Path(output)
         outputs = [("pdf", output), ("png", output.with_suffix(".png"))]
-        with recording(record, outputs, run_id=_derived_run_id(plugin, params, [p for _, p in files]),
-                       kind="figure", plugin=plugin.name, plugin_version=plugin.version,
-                       code_hash=code_hash(plugin.module), params=params_to_dict(params), inputs=files):
+        with _plugin_recording(record, outputs, plugin, params,
+                               _derived_run_id(plugin, params, [p for _, p in files]), inputs=files):
             print(f"figure {plugin.name} {plugin.version} from {len(files)} file(s)")
             plugin.run(params, {k: [Path(p) for p in v] for k, v in inputs.items()}, output)
 
