@@ -1,0 +1,134 @@
+"""Event-driven quasistatic loading: linear response, elastic step to the brink, kick.
+
+The linear (purely elastic) response ``du`` to a unit change of the drive is
+computed once. Along it, the interface strain changes linearly,
+``eps(s) = eps + s deps``, so the step ``s`` at which a Gauss point reaches a
+target equivalent strain solves a quadratic. As in FrictionQPotFEM
+(``eventDrivenStep(..., iterative=True)``): the candidate steps of all Gauss points
+are sorted and tried in turn until a well index changes (with ``yield_element``:
+until all four points of some element changed), then bisected until
+``(right - left) / left < 1e-5``. An elastic load step applies ``left``
+(largest step without any index change, targets ``eps_y,right - deps / 2``); a
+kick applies ``right`` (smallest step that changes an index, targets
+``eps_y,right + deps / 2``).
+Reference: shared/reference-model.md, section 8a-8b.
+"""
+
+import numpy as np
+
+from ..numba_options import njit
+from .materials import equivalent_strain, well_index
+
+__all__ = ["step_size", "autoscale", "BISECTION_RTOL", "MAX_BISECTIONS"]
+
+#: Relative width at which the bisection stops.
+BISECTION_RTOL = 1e-5
+#: Maximum number of bisection iterations.
+MAX_BISECTIONS = 1000
+
+
+@njit
+def _yields(epsy, eps, deps, idx, s, yield_element):
+    """Whether the trial strain ``eps + s deps`` changes an index (or all 4 of an element)."""
+    for e in range(idx.shape[0]):
+        changed = 0
+        for q in range(4):
+            xx = eps[e, q, 0] + s * deps[e, q, 0]
+            yy = eps[e, q, 1] + s * deps[e, q, 1]
+            xy = eps[e, q, 2] + s * deps[e, q, 2]
+            if well_index(epsy[e], equivalent_strain(xx, yy, xy), idx[e, q]) != idx[e, q]:
+                changed += 1
+        if yield_element:
+            if changed == 4:
+                return True
+        elif changed > 0:
+            return True
+    return False
+
+
+@njit
+def step_size(epsy, eps, deps, idx, deps_kick, kick, yield_element):
+    """Step along the linear response to the brink of yielding (load) or just past it (kick).
+
+    Parameters
+    ----------
+    epsy : numpy.ndarray
+        [ni, ny] yield strains.
+    eps : numpy.ndarray
+        [ni, 4, 3] current interface strain (xx, yy, xy).
+    deps : numpy.ndarray
+        [ni, 4, 3] interface strain of the linear response.
+    idx : numpy.ndarray
+        int64 [ni, 4] current well indices.
+    deps_kick : float
+        Kick size in equivalent strain.
+    kick : bool
+        Kick (True) or elastic load step (False).
+    yield_element : bool
+        Kick: require all 4 Gauss points of one element to change well.
+
+    Returns
+    -------
+    float
+        The step ``s`` (>= 0); 0 for a load step when a point is already within
+        ``deps_kick / 2`` of yielding; -1 if no candidate step yields (error).
+    """
+    ni = idx.shape[0]
+    sign = 1.0 if kick else -1.0
+    candidates = np.empty(ni * 4)
+    for e in range(ni):
+        for q in range(4):
+            target = epsy[e, idx[e, q] + 1] + sign * 0.5 * deps_kick
+            et = 0.5 * (eps[e, q, 0] - eps[e, q, 1])
+            gt = eps[e, q, 2]
+            if not kick and target < equivalent_strain(eps[e, q, 0], eps[e, q, 1], eps[e, q, 2]):
+                return 0.0
+            ed = 0.5 * (deps[e, q, 0] - deps[e, q, 1])
+            gd = deps[e, q, 2]
+            a = ed * ed + gd * gd
+            b = 2.0 * (et * ed + gt * gd)
+            c = et * et + gt * gt - target * target
+            candidates[e * 4 + q] = abs((-b + np.sqrt(b * b - 4.0 * a * c)) / (2.0 * a))
+    candidates.sort()
+    i = 0
+    while i < candidates.size and not _yields(epsy, eps, deps, idx, candidates[i], yield_element and kick):
+        i += 1
+    if i == candidates.size:
+        return -1.0
+    right = candidates[i]
+    left = candidates[i - 1] if i > 0 else 0.0
+    for _ in range(MAX_BISECTIONS):
+        mid = 0.5 * (right + left)
+        if _yields(epsy, eps, deps, idx, mid, yield_element and kick):
+            right = mid
+        else:
+            left = mid
+        if (right - left) / left < BISECTION_RTOL:
+            break
+    return right if kick else left
+
+
+@njit
+def autoscale(epsy, deps):
+    """Scale factor of the linear response: ``0.1 * min well width / max eps_eq(deps)``.
+
+    Parameters
+    ----------
+    epsy : numpy.ndarray
+        [ni, ny] yield strains.
+    deps : numpy.ndarray
+        [ni, 4, 3] interface strain of the unscaled response.
+
+    Returns
+    -------
+    float
+    """
+    width = np.inf
+    for e in range(epsy.shape[0]):
+        for j in range(epsy.shape[1] - 1):
+            width = min(width, epsy[e, j + 1] - epsy[e, j])
+    largest = 0.0
+    for e in range(deps.shape[0]):
+        for q in range(4):
+            largest = max(largest, equivalent_strain(deps[e, q, 0], deps[e, q, 1], deps[e, q, 2]))
+    return 0.1 * width / largest

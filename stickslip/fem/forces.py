@@ -1,0 +1,144 @@
+"""Internal force of the model: elastic plates, cusp interfaces and drive springs.
+
+``f(u) = K_plates u + sum_interface int B^T sigma_cusp dV + f_drive`` on DOF vectors.
+The drive adds, on every layer ``l`` with an active spring, the uniform body
+force ``k (ubar_l - target_l)`` per unit volume (nodal equivalent
+``k (ubar_l - target_l) V_l w_l``, :mod:`.assembly`). With a free lever the
+targets follow the lever's moment balance at every evaluation
+(``x_lever = (x_target + sum_l r_l ubar_l) / (1 + sum_l r_l^2)``,
+``target_l = r_l x_lever``, ``r_l = h_l / H``, sums over driven layers).
+
+Deterministic whatever the number of threads: rows of the sparse product and
+interface elements are computed independently; the interface forces are added
+to the DOF vector in one serial pass in element order.
+Reference: shared/reference-model.md, sections 2, 6 and 7.
+"""
+
+import numpy as np
+from numba import prange
+
+from ..numba_options import njit
+from .materials import cusp_stress, equivalent_strain, well_index
+
+__all__ = ["compute_force", "interface_strain", "layer_ubar"]
+
+
+@njit
+def interface_strain(dNdx, ue, out):
+    """Strain ``(xx, yy, xy)`` at the 4 Gauss points of one element.
+
+    Parameters
+    ----------
+    dNdx : numpy.ndarray
+        [4, 4, 2] gradients of the element [1/length].
+    ue : numpy.ndarray
+        [8] element displacement (node-major, x then y) [length].
+    out : numpy.ndarray
+        [4, 3] written.
+    """
+    for q in range(4):
+        xx = 0.0
+        yy = 0.0
+        xy = 0.0
+        for m in range(4):
+            gx = dNdx[q, m, 0]
+            gy = dNdx[q, m, 1]
+            ux = ue[2 * m]
+            uy = ue[2 * m + 1]
+            xx += gx * ux
+            yy += gy * uy
+            xy += gy * ux + gx * uy
+        out[q, 0] = xx
+        out[q, 1] = yy
+        out[q, 2] = 0.5 * xy
+
+
+@njit(parallel=True)
+def _plates_force(ptr, col, val, u, f):
+    # plain arrays only: numba loses writes to named-tuple fields inside prange
+    for i in prange(f.size):
+        s = 0.0
+        for j in range(ptr[i], ptr[i + 1]):
+            s += val[j] * u[col[j]]
+        f[i] = s
+
+
+@njit(parallel=True)
+def _interface_forces(iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe):
+    for e in prange(iface_dofs.shape[0]):
+        ue = np.empty(8)
+        for a in range(8):
+            ue[a] = u[iface_dofs[e, a]]
+        interface_strain(dNdx[e], ue, eps[e])
+        for a in range(8):
+            fe[e, a] = 0.0
+        for q in range(4):
+            xx = eps[e, q, 0]
+            yy = eps[e, q, 1]
+            xy = eps[e, q, 2]
+            i = well_index(epsy[e], equivalent_strain(xx, yy, xy), idx[e, q])
+            idx[e, q] = i
+            eps_min = 0.5 * (epsy[e, i] + epsy[e, i + 1])
+            sxx, syy, sxy = cusp_stress(xx, yy, xy, K, G, eps_min)
+            sig[e, q, 0] = sxx
+            sig[e, q, 1] = syy
+            sig[e, q, 2] = sxy
+            dV = iface_dV[e, q]
+            for m in range(4):
+                gx = dNdx[e, q, m, 0]
+                gy = dNdx[e, q, m, 1]
+                fe[e, 2 * m] += dV * (gx * sxx + gy * sxy)
+                fe[e, 2 * m + 1] += dV * (gx * sxy + gy * syy)
+
+
+@njit
+def layer_ubar(model, u, out):
+    """Volume-averaged x-displacement of every layer, ``out[l] = w_l . u`` [length]."""
+    for layer in range(model.layer_volume.size):
+        s = 0.0
+        for j in range(model.layer_ptr[layer], model.layer_ptr[layer + 1]):
+            s += model.layer_w[j] * u[model.layer_xdofs[j]]
+        out[layer] = s
+
+
+@njit
+def _drive(model, state):
+    layer_ubar(model, state.u, state.ubar)
+    if model.free_lever:
+        num = state.lever[0]
+        den = 1.0
+        for layer in range(model.layer_volume.size):
+            if model.drive_active[layer]:
+                num += model.lever_ratio[layer] * state.ubar[layer]
+                den += model.lever_ratio[layer] ** 2
+        state.lever[1] = num / den
+        for layer in range(model.layer_volume.size):
+            if model.drive_active[layer]:
+                state.target[layer] = model.lever_ratio[layer] * state.lever[1]
+    for layer in range(model.layer_volume.size):
+        if model.drive_active[layer]:
+            scale = model.k_drive * (state.ubar[layer] - state.target[layer]) * model.layer_volume[layer]
+            for j in range(model.layer_ptr[layer], model.layer_ptr[layer + 1]):
+                state.f[model.layer_xdofs[j]] += scale * model.layer_w[j]
+
+
+@njit
+def compute_force(model, state, fe):
+    """Evaluate ``state.f`` (and interface strain, stress, well index, ubar, drive targets) from ``state.u``.
+
+    Parameters
+    ----------
+    model : Model
+    state : State
+        ``u``, ``target`` and ``lever[0]`` are read; ``f``, ``idx``, ``eps``,
+        ``sig``, ``ubar`` (and with a free lever ``target``, ``lever[1]``) are written.
+    fe : numpy.ndarray
+        [ni, 8] work array.
+    """
+    _plates_force(model.k_ptr, model.k_col, model.k_val, state.u, state.f)
+    _interface_forces(model.iface_dofs, model.iface_dNdx, model.iface_dV, model.epsy, model.K, model.G,
+                      state.u, state.idx, state.eps, state.sig, fe)
+    for e in range(model.iface_dofs.shape[0]):
+        for a in range(8):
+            state.f[model.iface_dofs[e, a]] += fe[e, a]
+    _drive(model, state)

@@ -1,0 +1,130 @@
+"""The discretised model as arrays (``Model``, fixed) and its mutable state (``State``).
+
+Both are named tuples of numpy arrays and scalars so that the numba kernels of
+:mod:`.forces`, :mod:`.dynamics` and :mod:`.minimise` take them whole.
+Units: lengths in units of the block size's own unit (``h = pi``), stress in
+units of ``G``, time in units of ``h / (20 pi c) / dt``... i.e. the FE model's
+own units (``G = 1``, ``rho = 1``, shear-wave speed ``c_s = sqrt(G / 2 / rho)``).
+"""
+
+from collections import namedtuple
+
+import numpy as np
+
+from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, layer_average_weights,
+                       lumped_diagonal)
+from .quad4 import element_coordinates, shape_gradients
+
+__all__ = ["Model", "State", "build_model", "new_state"]
+
+Model = namedtuple("Model", [
+    "ndof",           # int: number of DOFs
+    "dt",             # float: time step [time]
+    "k_ptr", "k_col", "k_val",  # CSR [ndof, ndof] elastic stiffness of the plates [stress]
+    "mass_inv",       # float64 [ndof]: 1 / lumped mass on free DOFs, 0 on prescribed DOFs
+    "damping",        # float64 [ndof]: lumped background damping [mass / time]
+    "prescribed",     # bool [ndof]
+    "multiplicity",   # float64 [ndof]: nodes sharing the DOF (for node-vector norms)
+    "iface_dofs",     # int64 [ni, 8]: DOFs of the interface elements (interface by interface, blocks left to right)
+    "iface_dNdx",     # float64 [ni, 4, 4, 2] [1/length]
+    "iface_dV",       # float64 [ni, 4] [length^2]
+    "epsy",           # float64 [ni, ny]: yield strains per interface element [strain]
+    "K", "G",         # float: moduli [stress]
+    "layer_ptr",      # int64 [nlayer + 1]: slices of layer_xdofs / layer_w
+    "layer_xdofs",    # int64 [sum m_l]
+    "layer_w",        # float64 [sum m_l]: ubar_x = sum w u [1]
+    "layer_volume",   # float64 [nlayer] [length^2]
+    "drive_active",   # bool [nlayer]: layer has a drive spring in x
+    "k_drive",        # float: spring stiffness per unit volume [stress / length^2]
+    "free_lever",     # bool: targets follow the moment balance of a free lever
+    "lever_ratio",    # float64 [nlayer]: h_l / H (free lever), layer height over drive height
+])
+
+State = namedtuple("State", [
+    "u", "v", "a",    # float64 [ndof]: displacement [length], velocity, acceleration
+    "f",              # float64 [ndof]: internal force (material + drive, no damping) [force]
+    "idx",            # int64 [ni, 4]: current well per interface Gauss point
+    "eps", "sig",     # float64 [ni, 4, 3]: interface strain (xx, yy, xy) and stress
+    "target",         # float64 [nlayer]: drive target of ubar_x per layer [length]
+    "ubar",           # float64 [nlayer]: volume-averaged x-displacement per layer [length]
+    "lever",          # float64 [2]: (drive target x_target, lever position x_lever) at height H [length]
+    "t",              # float64 [1]: time [time]
+])
+
+
+def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height):
+    """Assemble the model arrays of a layered mesh.
+
+    Parameters
+    ----------
+    mesh : stickslip.mesh.LayeredMesh
+        Needs ``coor``, ``conn``, ``dofs``, ``iip``, ``elem_layer``, ``nlayer``,
+        ``layer_is_plastic``, ``layer_mid_height``, ``interface_elements``.
+    epsy : numpy.ndarray
+        [n_interfaces * N, ny] yield strains, rows in ``interface_elements`` order.
+    K, G : float
+        Bulk-like and shear-like moduli (same in plates and interfaces) [stress].
+    rho, alpha : float
+        Mass density and background damping density.
+    dt : float
+        Time step.
+    k_drive : float
+        Drive spring stiffness per unit volume.
+    drive_active : numpy.ndarray
+        bool [nlayer].
+    free_lever : bool
+    lever_height : float
+        Height ``H`` of the drive spring on the lever (free lever only; > 0).
+
+    Returns
+    -------
+    Model
+    """
+    conn = np.asarray(mesh.conn, dtype=np.int64)
+    dofs = np.asarray(mesh.dofs, dtype=np.int64)
+    ndof = int(dofs.max()) + 1
+    xe = element_coordinates(mesh.coor, conn)
+    dNdx, dV = shape_gradients(xe)
+    edofs = element_dofs(conn, dofs)
+    plastic_layer = np.asarray(mesh.layer_is_plastic, dtype=bool)
+    elem_layer = np.asarray(mesh.elem_layer, dtype=np.int64)
+    elastic = np.flatnonzero(~plastic_layer[elem_layer])
+    iface = np.asarray(mesh.interface_elements, dtype=np.int64).ravel()
+    if epsy.shape[0] != iface.size:
+        raise ValueError(f"epsy has {epsy.shape[0]} rows; expected one per interface element ({iface.size})")
+
+    k_ptr, k_col, k_val = assemble_csr(edofs[elastic], elastic_element_stiffness(dNdx[elastic], dV[elastic], K, G),
+                                       ndof)
+    nelem = conn.shape[0]
+    mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
+    damping = lumped_diagonal(xe, edofs, np.full(nelem, alpha), ndof)
+    prescribed = np.zeros(ndof, dtype=bool)
+    prescribed[np.asarray(mesh.iip, dtype=np.int64)] = True
+    mass_inv = np.where(prescribed, 0.0, 1.0 / mass)
+    multiplicity = np.bincount(dofs.ravel(), minlength=ndof).astype(np.float64)
+
+    ptr, xdofs, weights, volume = [0], [], [], []
+    for layer in range(mesh.nlayer):
+        d, w, v = layer_average_weights(edofs, dV, np.flatnonzero(elem_layer == layer), ndof)
+        xdofs.append(d)
+        weights.append(w)
+        volume.append(v)
+        ptr.append(ptr[-1] + d.size)
+    heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
+    return Model(
+        ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, mass_inv=mass_inv, damping=damping,
+        prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
+        iface_dV=dV[iface], epsy=np.ascontiguousarray(epsy, dtype=np.float64), K=float(K), G=float(G),
+        layer_ptr=np.asarray(ptr, dtype=np.int64), layer_xdofs=np.concatenate(xdofs),
+        layer_w=np.concatenate(weights), layer_volume=np.asarray(volume),
+        drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),
+        lever_ratio=heights / float(lever_height))
+
+
+def new_state(model):
+    """A state at rest: zero displacement, velocity, targets and time (forces not yet evaluated)."""
+    ni = model.iface_dofs.shape[0]
+    nlayer = model.layer_volume.size
+    return State(u=np.zeros(model.ndof), v=np.zeros(model.ndof), a=np.zeros(model.ndof), f=np.zeros(model.ndof),
+                 idx=np.zeros((ni, 4), dtype=np.int64), eps=np.zeros((ni, 4, 3)), sig=np.zeros((ni, 4, 3)),
+                 target=np.zeros(nlayer), ubar=np.zeros(nlayer), lever=np.zeros(2), t=np.zeros(1))

@@ -1,0 +1,53 @@
+"""Parameters of the finite-element model (the ``fem`` solver), defaults as the paper's code.
+
+Units are those of the FE model: lengths in the unit in which the block size is
+``h = pi``, moduli in units of ``G`` (= 1), density ``rho`` (= 1); strains are
+dimensionless. See docs/fem.md and shared/reference-model.md (section 11).
+"""
+
+import dataclasses
+
+from ..params import ParameterError, param
+
+__all__ = ["FemParams", "DRIVES"]
+
+#: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
+DRIVES = ("fixed-lever", "free-lever")
+
+
+@dataclasses.dataclass(frozen=True)
+class FemParams:
+    """Parameters of one simulation of the stack (see the field docs for units)."""
+
+    N: int = param(1458, "blocks per interface (mesh: 2*3^k, or small values such as 9)", minimum=3)
+    plates: int = param(2, "number of elastic plates (n = plates - 1 interfaces)", minimum=2, maximum=6)
+    seed: int = param(0, "realisation id; the disorder of element e of the interfaces uses pcg32 seed "
+                         "seed*N*99 + e", minimum=0)
+    k_drive: float = param(1e-3, "drive spring stiffness per unit volume (1e-3 stiff, 1e-6 compliant)",
+                           unit="G/h^2", exclusive_minimum=0.0)
+    drive: str = param("fixed-lever", "drive configuration", choices=DRIVES)
+    nchunk: int = param(6000, "random yield strains per block (the run stops `margin` wells before the end)",
+                        minimum=10)
+    G: float = param(1.0, "shear modulus G = 2 mu (plates and interfaces)", unit="stress", exclusive_minimum=0.0)
+    K: float = param(4.5, "bulk-like modulus K (energy K eps_m^2, eps_m = tr(eps)/2)", unit="stress",
+                     exclusive_minimum=0.0)
+    rho: float = param(1.0, "mass density", unit="mass/length^2", exclusive_minimum=0.0)
+    eps0: float = param(5e-5, "typical yield strain (well widths 2 eps0 Weibull + eps_offset)",
+                        exclusive_minimum=0.0)
+    eps_offset: float = param(1e-6, "minimal well width", minimum=0.0)
+    weibull_k: float = param(2.0, "Weibull shape parameter of the well widths", exclusive_minimum=0.0)
+    deps: float = param(1e-4, "kick size in equivalent strain", unit="eps0", exclusive_minimum=0.0)
+    tol: float = param(1e-5, "minimisation: relative residual tolerance", exclusive_minimum=0.0, maximum=0.5)
+    niter_tol: int = param(20, "minimisation: consecutive steps below tol (and non-increasing)", minimum=1)
+    max_iter: int = param(10_000_000, "minimisation: maximum time steps (then the run fails)", minimum=1)
+    margin: int = param(5, "stop when a block comes within this many wells of the end of its sequence",
+                        minimum=1)
+    lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",
+                                unit="H_1 - H_0 (mid-height distance of layers 1 and 0)", exclusive_minimum=0.0)
+    max_increments: int = param(0, "stop after this many increments (0: run until the margin stop)", minimum=0)
+
+    def check(self):
+        """Check conditions across fields."""
+        if self.nchunk <= 2 * self.margin:
+            raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
+                                 f"(margin = {self.margin}); expected nchunk > 2 * margin")

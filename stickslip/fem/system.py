@@ -1,0 +1,222 @@
+"""The simulated stack: model arrays, current state and the steps of the event-driven protocol.
+
+:class:`System` holds a :class:`.model.Model` and a :class:`.model.State` and
+offers the operations of the quasistatic protocol (shared/reference-model.md,
+section 8): the linear response, the elastic load step, the kick, the
+minimisation, and restoring a stored state.
+"""
+
+import math
+
+import numpy as np
+
+from .event_driven import autoscale, step_size
+from .forces import compute_force
+from .minimise import MAX_ITER_REACHED, minimise
+from .model import build_model, new_state
+from .yield_strains import interface_initstate, yield_strains
+
+__all__ = ["System", "SolverError", "derived_constants"]
+
+
+class SolverError(RuntimeError):
+    """The protocol cannot continue (no convergence, no yielding step found)."""
+
+
+def derived_constants(params, mesh):
+    """Constants that follow from the parameters and the mesh.
+
+    Parameters
+    ----------
+    params : FemParams
+    mesh : stickslip.mesh.LayeredMesh
+
+    Returns
+    -------
+    dict
+        ``L`` (periodic length), ``c`` = sqrt(G / rho), ``c_s`` = sqrt(G / 2 / rho)
+        (shear-wave speed), ``alpha`` = sqrt(2) (2 pi / L) c rho (critical damping of
+        the shear wave of wavelength L), ``dt`` = h / (2 pi c) / 10, ``sig0`` = 2 G eps0,
+        ``deps`` (kick, strain), ``H`` (free-lever drive height).
+    """
+    h = float(mesh.h)
+    L = mesh.N * h
+    c = math.sqrt(params.G / params.rho)
+    heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
+    return {
+        "h": h, "L": L, "c": c, "c_s": math.sqrt(params.G / 2.0 / params.rho),
+        "alpha": math.sqrt(2.0) * (2.0 * math.pi / L) * c * params.rho,
+        "dt": (1.0 / (c * 2.0 * math.pi / h)) / 10.0,
+        "sig0": 2.0 * params.G * params.eps0,
+        "deps": params.deps * params.eps0,
+        "H": params.lever_height * float(heights[1] - heights[0]),
+    }
+
+
+class System:
+    """A stack of plates and interfaces driven by springs (fixed or free lever).
+
+    Parameters
+    ----------
+    params : FemParams
+    mesh : stickslip.mesh.LayeredMesh
+
+    Attributes
+    ----------
+    model : Model
+    state : State
+    constants : dict
+        See :func:`derived_constants`.
+    delta_u, delta_eps, delta_target, delta_lever
+        Scaled linear response (None until :meth:`set_linear_response` or
+        :meth:`compute_linear_response`): displacement [ndof], interface strain
+        [ni, 4, 3], layer targets [nlayer], lever drive target (free lever).
+    """
+
+    def __init__(self, params, mesh):
+        self.params = params
+        self.mesh = mesh
+        self.constants = derived_constants(params, mesh)
+        initstate = interface_initstate(params.seed, mesh.N, mesh.n_interfaces)
+        epsy = yield_strains(initstate, params.nchunk, params.eps0, params.eps_offset, params.weibull_k)
+        if np.min(np.diff(epsy, axis=1)) <= self.constants["deps"]:
+            raise SolverError("a well is narrower than the kick 'deps'; use a smaller 'deps' or larger 'eps_offset'")
+        plastic = np.asarray(mesh.layer_is_plastic, dtype=bool)
+        self.drive_active = ~plastic & (np.arange(mesh.nlayer) > 0)
+        self.heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
+        c = self.constants
+        self.model = build_model(mesh, epsy=epsy, K=params.K, G=params.G, rho=params.rho, alpha=c["alpha"],
+                                 dt=c["dt"], k_drive=params.k_drive, drive_active=self.drive_active,
+                                 free_lever=params.drive == "free-lever", lever_height=c["H"])
+        self.state = new_state(self.model)
+        self._fe = np.zeros((self.model.iface_dofs.shape[0], 8))
+        self.delta_u = self.delta_eps = self.delta_target = None
+        self.delta_lever = 0.0
+        self.refresh()
+
+    # --- state -----------------------------------------------------------------------------
+
+    def refresh(self):
+        """Recompute forces, interface strain/stress/indices and drive targets from ``state.u``."""
+        compute_force(self.model, self.state, self._fe)
+
+    def restore(self, u, target, lever_target, t):
+        """Set a stored state (at rest) and recompute everything that follows from it.
+
+        Parameters
+        ----------
+        u : numpy.ndarray
+            [ndof] displacement.
+        target : numpy.ndarray
+            [nlayer] drive targets (fixed lever; recomputed for a free lever).
+        lever_target : float
+            Free lever: drive target ``x_target``.
+        t : float
+            Time.
+        """
+        s = self.state
+        s.u[:] = u
+        s.v[:] = 0.0
+        s.a[:] = 0.0
+        s.target[:] = target
+        s.lever[0] = lever_target
+        s.t[0] = t
+        self.refresh()
+
+    def snapshot(self):
+        """Copies of what :meth:`restore` needs: (u, target, lever_target, t)."""
+        s = self.state
+        return s.u.copy(), s.target.copy(), float(s.lever[0]), float(s.t[0])
+
+    # --- protocol --------------------------------------------------------------------------
+
+    def minimise(self, margin=0, record=False):
+        """Minimise by damped dynamics (:func:`.minimise.minimise`).
+
+        Returns
+        -------
+        niter : int
+            Steps if converged, 0 if stopped by the margin.
+        events : numpy.ndarray
+            [nevent, 3] (element, time, direction) when ``record``.
+
+        Raises
+        ------
+        SolverError
+            If ``max_iter`` steps do not converge.
+        """
+        p = self.params
+        niter, events = minimise(self.model, self.state, self._fe, p.tol, p.niter_tol, p.max_iter, margin, record)
+        if niter == MAX_ITER_REACHED:
+            raise SolverError(f"minimisation did not converge in max_iter = {p.max_iter} steps")
+        return niter, events
+
+    def compute_linear_response(self):
+        """Compute the scaled elastic response to a unit drive (all interfaces elastic).
+
+        Fixed lever: targets ``2 eps0 H_l`` (affine simple shear ``gamma = eps0``);
+        free lever: lever drive target ``eps0``. Minimised from rest, then scaled so that
+        the largest interface equivalent strain is 0.1 of the narrowest well.
+        The current state is not changed.
+        """
+        huge = np.finfo(np.float64).max
+        elastic = self.model._replace(epsy=np.tile(np.array([[-huge, huge]]), (self.model.epsy.shape[0], 1)))
+        saved = self.state
+        self.state = new_state(elastic)
+        unit_target = 2.0 * self.params.eps0 * self.heights
+        self.state.target[:] = unit_target
+        self.state.lever[0] = self.params.eps0
+        model = self.model
+        self.model = elastic
+        try:
+            self.refresh()
+            self.minimise()
+            u, eps = self.state.u.copy(), self.state.eps.copy()
+        finally:
+            self.model = model
+            self.state = saved
+        scale = autoscale(self.model.epsy, eps)
+        self.set_linear_response(scale * u, scale * eps, scale * unit_target, scale * self.params.eps0)
+
+    def set_linear_response(self, delta_u, delta_eps, delta_target, delta_lever):
+        """Set a (stored) scaled linear response; see the class attributes."""
+        self.delta_u = np.asarray(delta_u, dtype=np.float64)
+        self.delta_eps = np.asarray(delta_eps, dtype=np.float64)
+        self.delta_target = np.asarray(delta_target, dtype=np.float64)
+        self.delta_lever = float(delta_lever)
+
+    def event_step(self, kick, yield_element=False):
+        """Elastic load step to the brink of yielding, or kick past it (no dynamics).
+
+        Parameters
+        ----------
+        kick : bool
+        yield_element : bool
+            Kick until all Gauss points of one element change well.
+
+        Returns
+        -------
+        float
+            The step along the linear response (0: already at the brink).
+
+        Raises
+        ------
+        SolverError
+            If no yielding step exists or the step broke its promise (an index changed
+            during a load step, or none during a kick).
+        """
+        s = self.state
+        idx = s.idx.copy()
+        step = step_size(self.model.epsy, s.eps, self.delta_eps, idx, self.constants["deps"], kick,
+                         yield_element and kick)
+        if step < 0.0:
+            raise SolverError("no step along the linear response makes a block yield")
+        s.u[:] += step * self.delta_u
+        s.target[:] += step * self.delta_target
+        s.lever[0] += step * self.delta_lever
+        self.refresh()
+        changed = np.any(s.idx != idx)
+        if kick != changed:
+            raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
+                              f"{'did not change' if kick else 'changed'}")
+        return step
