@@ -22,17 +22,15 @@ from .forces import compute_force
 __all__ = ["time_step", "residual"]
 
 
-# Parallel kernels take plain arrays: numba loses writes to named-tuple fields inside prange.
-
-@njit(parallel=True)
-def _predict(dt, u, v, a):
-    for i in prange(u.size):
+@njit
+def _predict(lo, hi, dt, u, v, a):
+    for i in range(lo, hi):
         u[i] += dt * v[i] + 0.5 * dt * dt * a[i]
 
 
-@njit(parallel=True)
-def _correct(dt, mass_inv, damping, f, v, a):
-    for i in prange(v.size):
+@njit
+def _correct(lo, hi, dt, mass_inv, damping, f, v, a):
+    for i in range(lo, hi):
         minv = mass_inv[i]
         d = damping[i]
         fi = f[i]
@@ -46,6 +44,22 @@ def _correct(dt, mass_inv, damping, f, v, a):
         ai = -(fi + d * vi) * minv
         v[i] = vi
         a[i] = ai
+
+
+# Parallel variants over blocks of DOFs (plain arrays: numba loses writes to named-tuple fields in prange).
+
+@njit(parallel=True)
+def _predict_parallel(nblock, dt, u, v, a):
+    n = u.size
+    for b in prange(nblock):
+        _predict(b * n // nblock, (b + 1) * n // nblock, dt, u, v, a)
+
+
+@njit(parallel=True)
+def _correct_parallel(nblock, dt, mass_inv, damping, f, v, a):
+    n = v.size
+    for b in prange(nblock):
+        _correct(b * n // nblock, (b + 1) * n // nblock, dt, mass_inv, damping, f, v, a)
 
 
 @njit
@@ -68,6 +82,13 @@ def residual(model, state):
 def time_step(model, state, fe):
     """Advance ``state`` by one time step ``model.dt`` (``fe``: [ni, 8] work array)."""
     state.t[0] += model.dt
-    _predict(model.dt, state.u, state.v, state.a)
-    compute_force(model, state, fe)
-    _correct(model.dt, model.mass_inv, model.damping, state.f, state.v, state.a)
+    m = model
+    if m.nblock > 1:
+        _predict_parallel(m.nblock, m.dt, state.u, state.v, state.a)
+    else:
+        _predict(0, m.ndof, m.dt, state.u, state.v, state.a)
+    compute_force(m, state, fe)
+    if m.nblock > 1:
+        _correct_parallel(m.nblock, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)
+    else:
+        _correct(0, m.ndof, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)

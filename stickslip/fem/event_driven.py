@@ -17,6 +17,7 @@ Reference: shared/reference-model.md, section 8a-8b.
 import numpy as np
 
 from ..numba_options import njit
+from .forces import interface_strain
 from .materials import equivalent_strain, well_index
 
 __all__ = ["step_size", "autoscale", "BISECTION_RTOL", "MAX_BISECTIONS"]
@@ -28,15 +29,21 @@ MAX_BISECTIONS = 1000
 
 
 @njit
-def _yields(epsy, eps, deps, idx, s, yield_element):
-    """Whether the trial strain ``eps + s deps`` changes an index (or all 4 of an element)."""
+def _yields(epsy, dofs, dNdx, u, du, idx, s, yield_element):
+    """Whether the trial displacement ``u + s du`` changes an index (or all 4 of an element).
+
+    The trial strain is computed from the trial displacement exactly as the force
+    evaluation will compute it once the step is applied (same operations, same bits).
+    """
+    ue = np.empty(8)
+    eps = np.empty((4, 3))
     for e in range(idx.shape[0]):
+        for a in range(8):
+            ue[a] = u[dofs[e, a]] + s * du[dofs[e, a]]
+        interface_strain(dNdx[e], ue, eps)
         changed = 0
         for q in range(4):
-            xx = eps[e, q, 0] + s * deps[e, q, 0]
-            yy = eps[e, q, 1] + s * deps[e, q, 1]
-            xy = eps[e, q, 2] + s * deps[e, q, 2]
-            if well_index(epsy[e], equivalent_strain(xx, yy, xy), idx[e, q]) != idx[e, q]:
+            if well_index(epsy[e], equivalent_strain(eps[q, 0], eps[q, 1], eps[q, 2]), idx[e, q]) != idx[e, q]:
                 changed += 1
         if yield_element:
             if changed == 4:
@@ -47,13 +54,19 @@ def _yields(epsy, eps, deps, idx, s, yield_element):
 
 
 @njit
-def step_size(epsy, eps, deps, idx, deps_kick, kick, yield_element):
+def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_element):
     """Step along the linear response to the brink of yielding (load) or just past it (kick).
 
     Parameters
     ----------
     epsy : numpy.ndarray
         [ni, ny] yield strains.
+    dofs : numpy.ndarray
+        int64 [ni, 8] DOFs of the interface elements.
+    dNdx : numpy.ndarray
+        [ni, 4, 4, 2] their shape-function gradients.
+    u, du : numpy.ndarray
+        [ndof] current displacement and linear response.
     eps : numpy.ndarray
         [ni, 4, 3] current interface strain (xx, yy, xy).
     deps : numpy.ndarray
@@ -91,7 +104,7 @@ def step_size(epsy, eps, deps, idx, deps_kick, kick, yield_element):
             candidates[e * 4 + q] = abs((-b + np.sqrt(b * b - 4.0 * a * c)) / (2.0 * a))
     candidates.sort()
     i = 0
-    while i < candidates.size and not _yields(epsy, eps, deps, idx, candidates[i], yield_element and kick):
+    while i < candidates.size and not _yields(epsy, dofs, dNdx, u, du, idx, candidates[i], yield_element and kick):
         i += 1
     if i == candidates.size:
         return -1.0
@@ -99,7 +112,7 @@ def step_size(epsy, eps, deps, idx, deps_kick, kick, yield_element):
     left = candidates[i - 1] if i > 0 else 0.0
     for _ in range(MAX_BISECTIONS):
         mid = 0.5 * (right + left)
-        if _yields(epsy, eps, deps, idx, mid, yield_element and kick):
+        if _yields(epsy, dofs, dNdx, u, du, idx, mid, yield_element and kick):
             right = mid
         else:
             left = mid

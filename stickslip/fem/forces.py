@@ -9,8 +9,9 @@ targets follow the lever's moment balance at every evaluation
 ``target_l = r_l x_lever``, ``r_l = h_l / H``, sums over driven layers).
 
 Deterministic whatever the number of threads: rows of the sparse product and
-interface elements are computed independently; the interface forces are added
-to the DOF vector in one serial pass in element order.
+interface elements are computed independently (serially, or in ``model.nblock``
+parallel blocks); the interface forces are added to the DOF vector in one serial
+pass in element order.
 Reference: shared/reference-model.md, sections 2, 6 and 7.
 """
 
@@ -53,20 +54,19 @@ def interface_strain(dNdx, ue, out):
         out[q, 2] = 0.5 * xy
 
 
-@njit(parallel=True)
-def _plates_force(ptr, col, val, u, f):
-    # plain arrays only: numba loses writes to named-tuple fields inside prange
-    for i in prange(f.size):
+@njit
+def _plates_rows(lo, hi, ptr, col, val, u, f):
+    for i in range(lo, hi):
         s = 0.0
         for j in range(ptr[i], ptr[i + 1]):
             s += val[j] * u[col[j]]
         f[i] = s
 
 
-@njit(parallel=True)
-def _interface_forces(iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe):
-    for e in prange(iface_dofs.shape[0]):
-        ue = np.empty(8)
+@njit
+def _interface_elements(lo, hi, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe):
+    ue = np.empty(8)
+    for e in range(lo, hi):
         for a in range(8):
             ue[a] = u[iface_dofs[e, a]]
         interface_strain(dNdx[e], ue, eps[e])
@@ -89,6 +89,25 @@ def _interface_forces(iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, 
                 gy = dNdx[e, q, m, 1]
                 fe[e, 2 * m] += dV * (gx * sxx + gy * sxy)
                 fe[e, 2 * m + 1] += dV * (gx * sxy + gy * syy)
+
+
+# Parallel variants: blocks of rows / elements, each computed exactly as serially (so the
+# result does not depend on the number of threads). They take plain arrays: numba loses
+# writes to named-tuple fields inside prange.
+
+@njit(parallel=True)
+def _plates_rows_parallel(nblock, ptr, col, val, u, f):
+    n = f.size
+    for b in prange(nblock):
+        _plates_rows(b * n // nblock, (b + 1) * n // nblock, ptr, col, val, u, f)
+
+
+@njit(parallel=True)
+def _interface_elements_parallel(nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe):
+    n = iface_dofs.shape[0]
+    for b in prange(nblock):
+        _interface_elements(b * n // nblock, (b + 1) * n // nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u,
+                            idx, eps, sig, fe)
 
 
 @njit
@@ -135,9 +154,15 @@ def compute_force(model, state, fe):
     fe : numpy.ndarray
         [ni, 8] work array.
     """
-    _plates_force(model.k_ptr, model.k_col, model.k_val, state.u, state.f)
-    _interface_forces(model.iface_dofs, model.iface_dNdx, model.iface_dV, model.epsy, model.K, model.G,
-                      state.u, state.idx, state.eps, state.sig, fe)
+    m = model
+    if m.nblock > 1:
+        _plates_rows_parallel(m.nblock, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+        _interface_elements_parallel(m.nblock, m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G, state.u,
+                                     state.idx, state.eps, state.sig, fe)
+    else:
+        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+        _interface_elements(0, m.iface_dofs.shape[0], m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G,
+                            state.u, state.idx, state.eps, state.sig, fe)
     for e in range(model.iface_dofs.shape[0]):
         for a in range(8):
             state.f[model.iface_dofs[e, a]] += fe[e, a]

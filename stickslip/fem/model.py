@@ -38,6 +38,7 @@ Model = namedtuple("Model", [
     "k_drive",        # float: spring stiffness per unit volume [stress / length^2]
     "free_lever",     # bool: targets follow the moment balance of a free lever
     "lever_ratio",    # float64 [nlayer]: h_l / H (free lever), layer height over drive height
+    "nblock",         # int: 1 = serial kernels; > 1 = parallel kernels over this many blocks
 ])
 
 State = namedtuple("State", [
@@ -52,7 +53,8 @@ State = namedtuple("State", [
 ])
 
 
-def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height):
+def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height,
+                threads=1):
     """Assemble the model arrays of a layered mesh.
 
     Parameters
@@ -75,6 +77,9 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     free_lever : bool
     lever_height : float
         Height ``H`` of the drive spring on the lever (free lever only; > 0).
+    threads : int, optional
+        Number of threads of the parallel kernels (1: serial kernels). The results do
+        not depend on it.
 
     Returns
     -------
@@ -118,7 +123,7 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
         layer_ptr=np.asarray(ptr, dtype=np.int64), layer_xdofs=np.concatenate(xdofs),
         layer_w=np.concatenate(weights), layer_volume=np.asarray(volume),
         drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),
-        lever_ratio=heights / float(lever_height))
+        lever_ratio=heights / float(lever_height), nblock=4 * int(threads) if threads > 1 else 1)
 
 
 def new_state(model):

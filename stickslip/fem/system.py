@@ -60,6 +60,8 @@ class System:
     ----------
     params : FemParams
     mesh : stickslip.mesh.LayeredMesh
+    threads : int, optional
+        Threads of the parallel kernels (1: serial kernels); results do not depend on it.
 
     Attributes
     ----------
@@ -73,7 +75,7 @@ class System:
         [ni, 4, 3], layer targets [nlayer], lever drive target (free lever).
     """
 
-    def __init__(self, params, mesh):
+    def __init__(self, params, mesh, threads=1):
         self.params = params
         self.mesh = mesh
         self.constants = derived_constants(params, mesh)
@@ -87,7 +89,7 @@ class System:
         c = self.constants
         self.model = build_model(mesh, epsy=epsy, K=params.K, G=params.G, rho=params.rho, alpha=c["alpha"],
                                  dt=c["dt"], k_drive=params.k_drive, drive_active=self.drive_active,
-                                 free_lever=params.drive == "free-lever", lever_height=c["H"])
+                                 free_lever=params.drive == "free-lever", lever_height=c["H"], threads=threads)
         self.state = new_state(self.model)
         self._fe = np.zeros((self.model.iface_dofs.shape[0], 8))
         self.delta_u = self.delta_eps = self.delta_target = None
@@ -176,7 +178,8 @@ class System:
             self.model = model
             self.state = saved
         scale = autoscale(self.model.epsy, eps)
-        self.set_linear_response(scale * u, scale * eps, scale * unit_target, scale * self.params.eps0)
+        lever = scale * self.params.eps0 if self.model.free_lever else 0.0
+        self.set_linear_response(scale * u, scale * eps, scale * unit_target, lever)
 
     def set_linear_response(self, delta_u, delta_eps, delta_target, delta_lever):
         """Set a (stored) scaled linear response; see the class attributes."""
@@ -207,8 +210,9 @@ class System:
         """
         s = self.state
         idx = s.idx.copy()
-        step = step_size(self.model.epsy, s.eps, self.delta_eps, idx, self.constants["deps"], kick,
-                         yield_element and kick)
+        m = self.model
+        step = step_size(m.epsy, m.iface_dofs, m.iface_dNdx, s.u, self.delta_u, s.eps, self.delta_eps, idx,
+                         self.constants["deps"], kick, yield_element and kick)
         if step < 0.0:
             raise SolverError("no step along the linear response makes a block yield")
         s.u[:] += step * self.delta_u

@@ -1,0 +1,254 @@
+"""The simulation file: layout, appending increments, reading results, time-resolved reruns.
+
+One HDF5 file per run (written with :mod:`stickslip.h5io`, so equal runs give equal bytes):
+
+``/`` attributes
+    ``solver`` ("fem"), ``version`` (package), ``params`` (JSON of all :class:`FemParams`),
+    the main parameters again as typed attributes (``N``, ``plates``, ``n_interfaces``,
+    ``k_drive``, ``drive``, ``seed``, ``nchunk``), normalisation (``eps0``, ``sig0``,
+    ``gamma0`` [deg], ``c_s``, ``h``, ``dt``, ``alpha``, ``H``), ``nstored`` (complete
+    increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or "max_increments").
+``/mesh``
+    The layered mesh (:func:`stickslip.mesh.save_mesh`).
+``/event``
+    Scaled linear response: ``delta_u`` [ndof], ``delta_eps`` [ni, 4, 3],
+    ``delta_target`` [nlayer], ``delta_lever`` [1].
+``/state``
+    One row per increment, enough to restore it: ``u`` [ninc, ndof], ``target``
+    [ninc, nlayer], ``lever_target`` [ninc], ``t`` [ninc].
+``/increments``
+    The observables table (one 1-D dataset per column, attribute ``columns``,
+    readable by :func:`stickslip.h5io.read_table`): ``increment``, ``kick``,
+    ``yield_element`` and :func:`.observables.observable_columns`.
+"""
+
+import json
+
+import numpy as np
+import pandas as pd
+
+from .. import __version__
+from ..h5io import FileFormatError, open_file, read_table, write_attrs, write_dataset
+from ..mesh import load_mesh, save_mesh
+from ..params import parse_params, params_to_dict
+from .observables import observable_columns
+from .parameters import FemParams
+
+__all__ = ["create_file", "append_increment", "read_increments", "read_run_attrs", "read_params", "RunFile",
+           "rerun_with_failures"]
+
+_STATE = ("u", "target", "lever_target", "t")
+
+
+def create_file(file, system, observer):
+    """Write the header of a new simulation file (no increment yet).
+
+    Parameters
+    ----------
+    file : h5py.File
+        Open for writing, empty.
+    system : System
+        With its linear response set.
+    observer : Observer
+    """
+    p = system.params
+    c = system.constants
+    write_attrs(file, {
+        "solver": "fem", "version": __version__, "params": params_to_dict(p),
+        "N": p.N, "plates": p.plates, "n_interfaces": p.plates - 1, "k_drive": p.k_drive, "drive": p.drive,
+        "seed": p.seed, "nchunk": p.nchunk, "eps0": p.eps0, "sig0": c["sig0"], "gamma0": observer.gamma0,
+        "c_s": c["c_s"], "h": c["h"], "dt": c["dt"], "alpha": c["alpha"], "H": c["H"],
+        "nstored": 0, "completed": False, "stop_reason": "",
+    })
+    save_mesh(system.mesh, file.create_group("mesh"))
+    event = file.create_group("event")
+    write_dataset(event, "delta_u", system.delta_u)
+    write_dataset(event, "delta_eps", system.delta_eps)
+    write_dataset(event, "delta_target", system.delta_target)
+    write_dataset(event, "delta_lever", np.array([system.delta_lever]))
+    state = file.create_group("state")
+    ndof, nlayer = system.model.ndof, system.model.layer_volume.size
+    write_dataset(state, "u", np.zeros((0, ndof)), maxshape=(None, ndof), chunks=(1, ndof))
+    write_dataset(state, "target", np.zeros((0, nlayer)), maxshape=(None, nlayer), chunks=(64, nlayer))
+    for name in ("lever_target", "t"):
+        write_dataset(state, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
+    table = file.create_group("increments")
+    columns = ["increment", "kick", "yield_element"] + observable_columns(observer.nlayer, observer.n_interfaces)
+    dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool}
+    for name in columns:
+        dtype = dtypes.get(name, np.int64 if name[:2] in ("S_", "A_") else np.float64)
+        write_dataset(table, name, np.zeros(0, dtype=dtype), maxshape=(None,), chunks=(1024,))
+    table.attrs["columns"] = json.dumps(columns)
+
+
+def _append(dataset, value):
+    n = dataset.shape[0]
+    dataset.resize(n + 1, axis=0)
+    dataset[n] = value
+
+
+def append_increment(file, system, row):
+    """Append one increment (state and observables) and flush.
+
+    Parameters
+    ----------
+    file : h5py.File
+    system : System
+    row : dict
+        ``increment``, ``kick``, ``yield_element`` and the observables.
+    """
+    u, target, lever_target, t = system.snapshot()
+    for name, value in zip(_STATE, (u, target, lever_target, t)):
+        _append(file["state"][name], value)
+    table = file["increments"]
+    for name in json.loads(table.attrs["columns"]):
+        _append(table[name], row[name])
+    file.attrs["nstored"] = int(file["state/t"].shape[0])
+    file.flush()
+
+
+def truncate_to_stored(file):
+    """Drop a partly written increment (rows beyond the ``nstored`` attribute)."""
+    n = int(file.attrs["nstored"])
+    groups = [file["state"][name] for name in _STATE]
+    groups += [file["increments"][name] for name in json.loads(file["increments"].attrs["columns"])]
+    for dataset in groups:
+        if dataset.shape[0] != n:
+            dataset.resize(n, axis=0)
+
+
+def read_params(file):
+    """The :class:`FemParams` of an open simulation file.
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not a ``fem`` simulation file.
+    """
+    if file.attrs.get("solver") != "fem" or "params" not in file.attrs:
+        raise FileFormatError(f"{file.filename}: not a fem simulation file (attribute 'solver' != 'fem')")
+    return parse_params(FemParams, json.loads(file.attrs["params"]), owner="solver 'fem'")
+
+
+class RunFile:
+    """Read access to the stored states of a simulation file.
+
+    Parameters
+    ----------
+    file : h5py.File
+        Open simulation file.
+    """
+
+    def __init__(self, file):
+        self.file = file
+        self.params = read_params(file)
+        self.mesh = load_mesh(file["mesh"])
+        self.nstored = int(file.attrs["nstored"])
+
+    def state(self, increment):
+        """(u, target, lever_target, t) of a stored increment."""
+        if not 0 <= increment < self.nstored:
+            raise FileFormatError(f"{self.file.filename}: increment {increment} is not stored "
+                                  f"(0 ... {self.nstored - 1})")
+        s = self.file["state"]
+        return s["u"][increment], s["target"][increment], float(s["lever_target"][increment]), float(s["t"][increment])
+
+    def linear_response(self):
+        """(delta_u, delta_eps, delta_target, delta_lever) as stored."""
+        e = self.file["event"]
+        return e["delta_u"][...], e["delta_eps"][...], e["delta_target"][...], float(e["delta_lever"][0])
+
+
+def read_increments(path):
+    """Per-increment observables of a simulation file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per stored increment; columns ``increment``, ``kick``, ``yield_element``, ``t``,
+        ``gamma``, ``epsd``, ``sigd``, ``epsd_<l>``, ``sigd_<l>``, ``ubar_<l>``, ``fxdrive_<l>``,
+        ``S_a<a>``, ``A_a<a>`` (see :mod:`.observables`).
+    """
+    with open_file(path) as file:
+        read_params(file)
+        table = read_table(file, "increments")
+        return table.iloc[: int(file.attrs["nstored"])].reset_index(drop=True)
+
+
+def read_run_attrs(path):
+    """Parameters, normalisation and status of a simulation file.
+
+    Returns
+    -------
+    dict
+        ``N``, ``plates``, ``n_interfaces``, ``k_drive``, ``drive``, ``seed``, ``nchunk``,
+        ``completed``, ``stop_reason``, ``nstored``, ``eps0``, ``sig0``, ``gamma0``, ``c_s``,
+        ``h``, ``dt``, ``alpha``, ``H``, ``version``, ``params`` (dict).
+    """
+    with open_file(path) as file:
+        read_params(file)
+        out = {}
+        for key, value in file.attrs.items():
+            out[key] = value.item() if isinstance(value, np.generic) else value
+        out["params"] = json.loads(out["params"])
+        out["completed"] = bool(out["completed"])
+        return out
+
+
+def rerun_with_failures(path, increment):
+    """Redo the kick and minimisation of one increment, recording every block failure.
+
+    The state of ``increment - 1`` is restored, the stored kick is redone (with the
+    whole-element fallback if the increment used it) and the minimisation records
+    every change of the well index of Gauss point 0 of the interface blocks (the
+    kick's own change at ``t = 0`` included). The result must reproduce the stored
+    increment exactly (asserted).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    increment : int
+        A stored kick increment (>= 2).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``a`` (interface, 1 = lowest), ``block`` (0 ... N-1), ``t`` (time since the
+        kick [FE time units]), ``direction`` (+1 / -1); one row per well hop, in time order.
+
+    Raises
+    ------
+    FileFormatError
+        If the increment is not a stored kick.
+    """
+    from .system import System
+
+    with open_file(path) as file:
+        run = RunFile(file)
+        table = read_table(file, "increments")
+        if not 1 <= increment < run.nstored or not bool(table["kick"][increment]):
+            raise FileFormatError(f"{path}: increment {increment} is not a stored kick increment")
+        yield_element = bool(table["yield_element"][increment])
+        before = run.state(increment - 1)
+        after = run.state(increment)
+        response = run.linear_response()
+        system = System(run.params, run.mesh)
+    system.set_linear_response(*response)
+    system.restore(*before)
+    t0 = before[3]
+    N = run.mesh.N
+    index0 = system.state.idx[:, 0].copy()
+    system.event_step(True, yield_element=yield_element)
+    kicked = system.state.idx[:, 0] - index0
+    rows = [(e, t0, np.sign(kicked[e])) for e in np.flatnonzero(kicked) for _ in range(abs(int(kicked[e])))]
+    niter, events = system.minimise(margin=run.params.margin, record=True)
+    if niter == 0 or not np.array_equal(system.state.u, after[0]) or system.state.t[0] != after[3]:
+        raise AssertionError(f"{path}: rerunning increment {increment} did not reproduce the stored state")
+    events = np.concatenate([np.asarray(rows, dtype=np.float64).reshape(-1, 3), events])
+    element = events[:, 0].astype(np.int64)
+    return pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - t0,
+                         "direction": events[:, 2].astype(np.int64)})

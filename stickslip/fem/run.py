@@ -1,0 +1,125 @@
+"""The increment loop of the event-driven protocol, appending to the simulation file, with resume.
+
+Increment 0 is the unloaded state. Then, alternately: an elastic load step to
+the brink of yielding (odd increments), and a kick followed by minimisation
+(even increments). If a kick's minimisation ends with no well index changed
+(the kicked point fell back), the previous increment is restored and the kick
+redone so that a whole element yields (``yield_element``). The run stops, and
+is marked completed, when a block comes within ``margin`` wells of the end of
+its yield strains (during a minimisation, or after a load step), or after
+``max_increments`` increments. Every increment is appended and flushed; an
+interrupted run resumes from its last complete increment and gives the same
+file contents as an uninterrupted run.
+Reference: shared/reference-model.md, section 8c.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from ..h5io import FileFormatError, atomic_output, open_file
+from ..params import params_to_dict
+from .minimise import within_margin
+from .observables import Observer
+from .output import RunFile, append_increment, create_file, read_params, truncate_to_stored
+from .system import System
+
+__all__ = ["run_simulation"]
+
+
+def _row(observer, increment, kick, yield_element, previous_index):
+    row = {"increment": increment, "kick": kick, "yield_element": yield_element}
+    row.update(observer.observe(previous_index))
+    return row
+
+
+def _create(path, params, mesh):
+    system = System(params, mesh)
+    system.compute_linear_response()
+    observer = Observer(system)
+    with atomic_output(path) as tmp:
+        with open_file(tmp, "w") as file:
+            create_file(file, system, observer)
+            append_increment(file, system, _row(observer, 0, True, False, observer.well_index()))
+
+
+def _kick(system, margin):
+    """Kick and minimise, with the whole-element fallback; returns (converged, yield_element)."""
+    before = system.snapshot()
+    index = system.state.idx.copy()
+    system.event_step(True)
+    niter, _ = system.minimise(margin=margin)
+    if niter == 0:
+        return False, False
+    if np.array_equal(system.state.idx, index):
+        system.restore(*before)
+        system.event_step(True, yield_element=True)
+        niter, _ = system.minimise(margin=margin)
+        return niter != 0, True
+    return True, False
+
+
+def run_simulation(params, output, mesh):
+    """Run (or resume, or skip if completed) one simulation into ``output``.
+
+    Parameters
+    ----------
+    params : FemParams
+    output : str or pathlib.Path
+        Simulation file; created if absent, resumed if present and incomplete.
+    mesh : stickslip.mesh.LayeredMesh
+        Used when the file is created (a resumed file uses its own stored mesh).
+
+    Returns
+    -------
+    int
+        Number of increments stored by this call.
+
+    Raises
+    ------
+    FileFormatError
+        If ``output`` exists with other parameters, or is not a simulation file.
+    """
+    output = Path(output)
+    if not output.exists():
+        _create(output, params, mesh)
+    with open_file(output, "r+") as file:
+        stored = read_params(file)
+        if params_to_dict(stored) != params_to_dict(params):
+            raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
+        if bool(file.attrs["completed"]):
+            return 0
+        truncate_to_stored(file)
+        run = RunFile(file)
+        system = System(params, run.mesh)
+        system.set_linear_response(*run.linear_response())
+        increment = run.nstored - 1
+        system.restore(*run.state(increment))
+        observer = Observer(system)
+        kick = bool(file["increments/kick"][increment])
+        previous_index = observer.well_index()
+        new = 0
+        reason = ""
+        while not reason:
+            if params.max_increments and increment >= params.max_increments:
+                reason = "max_increments"
+                break
+            increment += 1
+            kick = not kick
+            yield_element = False
+            if kick:
+                converged, yield_element = _kick(system, params.margin)
+                if not converged:
+                    reason = "margin"
+                    break
+            else:
+                system.event_step(False)
+                if not within_margin(system.model, system.state.idx, params.margin):
+                    reason = "margin"
+                    break
+            append_increment(file, system, _row(observer, increment, kick, yield_element, previous_index))
+            previous_index = observer.well_index()
+            new += 1
+        file.attrs["completed"] = True
+        file.attrs["stop_reason"] = reason
+        return new
