@@ -61,7 +61,7 @@ BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "sticks
                    "stickslip.figures.fig3", "stickslip.figures.fig4", "stickslip.figures.fig5",
                    "stickslip.figures.fig6", "stickslip.figures.figs_individual",
                    "stickslip.figures.figs_slip_distributions", "stickslip.figures.figs_aging_variations",
-                   "stickslip.figures.figs_slow_slip")
+                   "stickslip.figures.figs_slow_slip", "stickslip.solvers.fem")
 
 _RUN_SIGNATURES = {
     "solver": (["params", "output"], ["threads", "inputs"]),

@@ -17,7 +17,7 @@ from ..registry import PluginError
 __all__ = ["main", "COMMANDS"]
 
 #: Sub-command modules, in the order of ``stickslip --help``.
-COMMANDS = ("mesh", "simulate", "analyze_experiment", "import_csv", "plugins", "db")
+COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db")
 
 USER_ERRORS = (ParameterError, PluginError, FileFormatError)
 

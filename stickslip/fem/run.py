@@ -33,8 +33,8 @@ def _row(observer, increment, kick, yield_element, previous_index):
     return row
 
 
-def _create(path, params, mesh):
-    system = System(params, mesh)
+def _create(path, params, mesh, threads):
+    system = System(params, mesh, threads=threads)
     system.compute_linear_response()
     observer = Observer(system)
     with atomic_output(path) as tmp:
@@ -59,7 +59,7 @@ def _kick(system, margin):
     return True, False
 
 
-def run_simulation(params, output, mesh):
+def run_simulation(params, output, mesh, threads=1):
     """Run (or resume, or skip if completed) one simulation into ``output``.
 
     Parameters
@@ -69,6 +69,8 @@ def run_simulation(params, output, mesh):
         Simulation file; created if absent, resumed if present and incomplete.
     mesh : stickslip.mesh.LayeredMesh
         Used when the file is created (a resumed file uses its own stored mesh).
+    threads : int, optional
+        Threads of the parallel kernels (1: serial); the file does not depend on it.
 
     Returns
     -------
@@ -82,7 +84,7 @@ def run_simulation(params, output, mesh):
     """
     output = Path(output)
     if not output.exists():
-        _create(output, params, mesh)
+        _create(output, params, mesh, threads)
     with open_file(output, "r+") as file:
         stored = read_params(file)
         if params_to_dict(stored) != params_to_dict(params):
@@ -91,7 +93,7 @@ def run_simulation(params, output, mesh):
             return 0
         truncate_to_stored(file)
         run = RunFile(file)
-        system = System(params, run.mesh)
+        system = System(params, run.mesh, threads=threads)
         system.set_linear_response(*run.linear_response())
         increment = run.nstored - 1
         system.restore(*run.state(increment))

@@ -1,0 +1,37 @@
+"""Solver ``fem``: the paper's finite-element model (shared/reference-model.md), one run per file.
+
+Parameters: :class:`stickslip.fem.parameters.FemParams` (every field documented
+with its unit; ``stickslip plugins --params`` lists them). The mesh is read from
+``inputs["mesh"]`` (a file of :func:`stickslip.mesh.write_mesh`) when given, else
+built from ``N`` and ``plates``. The output file (layout: :mod:`stickslip.fem.output`)
+is appended after every increment; an existing incomplete file with the same
+parameters is resumed, a completed one is left as it is.
+"""
+
+from .. import registry
+from ..fem.parameters import FemParams
+from ..fem.run import run_simulation
+from ..h5io import FileFormatError
+from ..mesh import MeshParams, build_stack_mesh, read_mesh
+
+__all__ = ["FemParams", "run", "VERSION"]
+
+#: Algorithm version (part of every run id); bump when results change.
+VERSION = "1"
+
+
+def _mesh(params, inputs):
+    path = (inputs or {}).get("mesh")
+    if path is None:
+        return build_stack_mesh(MeshParams(N=params.N, plates=params.plates))
+    mesh = read_mesh(path)
+    if (mesh.N, mesh.plates) != (params.N, params.plates):
+        raise FileFormatError(f"{path}: mesh has N = {mesh.N}, plates = {mesh.plates}; the run needs "
+                              f"N = {params.N}, plates = {params.plates}")
+    return mesh
+
+
+@registry.register("solver", "fem", VERSION, FemParams, inputs=("mesh",))
+def run(params, output, *, threads=1, inputs=None):
+    """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
+    run_simulation(params, output, _mesh(params, inputs), threads=threads)

@@ -1,0 +1,187 @@
+"""Verification of the fem kernels: random numbers, elements, elasticity, dynamics, event-driven steps."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from stickslip.fem.dynamics import time_step
+from stickslip.fem.event_driven import step_size
+from stickslip.fem.materials import equivalent_strain
+from stickslip.fem.model import build_model, new_state
+from stickslip.fem.observables import Observer
+from stickslip.fem.parameters import FemParams
+from stickslip.fem.random import pcg32_uint32, pcg32_uniform
+from stickslip.fem.system import System
+from stickslip.fem.forces import compute_force
+from stickslip.fem.yield_strains import interface_initstate, yield_strains
+from stickslip.mesh import MeshParams, build_stack_mesh
+
+
+def test_pcg32_reproduces_the_published_reference_outputs():
+    # O'Neill's pcg32-demo, pcg32_srandom_r(&rng, 42u, 54u): first six outputs
+    out = pcg32_uint32(np.array([42], dtype=np.uint64), np.array([54], dtype=np.uint64), 6)[0]
+    assert [int(x) for x in out] == [0xA15C02B7, 0x7B47F409, 0xBA1D3330, 0x83D2F293, 0xBFA4784B, 0xCBED606E]
+    assert pcg32_uniform([42], 54, 1)[0, 0] == 0xA15C02B7 / 2.0**32
+
+
+def test_yield_strains_statistics_and_seeding():
+    initstate = interface_initstate(seed=1, N=9, n_interfaces=2)
+    assert initstate[0] == 9 * 99 and initstate[-1] == 9 * 99 + 17
+    epsy = yield_strains(interface_initstate(0, 2000, 1), nchunk=200, eps0=5e-5, eps_offset=1e-6, k=2.0)
+    assert epsy.shape == (2000, 201)
+    np.testing.assert_array_equal(epsy[:, 0], -epsy[:, 1])  # symmetric first well
+    widths = np.diff(epsy[:, 1:], axis=1)
+    assert widths.min() >= 1e-6
+    # mean width 2 eps0 Gamma(3/2) + offset, std 2 eps0 sqrt(1 - pi / 4) (Weibull k = 2)
+    assert widths.mean() == pytest.approx(2 * 5e-5 * math.gamma(1.5) + 1e-6, rel=5e-3)
+    assert widths.std() == pytest.approx(2 * 5e-5 * math.sqrt(1 - math.pi / 4), rel=5e-3)
+    # same seed, same disorder on the first interface whatever the number of interfaces
+    one = yield_strains(interface_initstate(3, 9, 1), 50, 5e-5, 1e-6, 2.0)
+    two = yield_strains(interface_initstate(3, 9, 2), 50, 5e-5, 1e-6, 2.0)
+    np.testing.assert_array_equal(one, two[:9])
+
+
+@pytest.fixture(scope="module")
+def stack():
+    """A 3-plate stack with coarsening rows (N = 18)."""
+    mesh = build_stack_mesh(MeshParams(N=18, plates=3))
+    return System(FemParams(N=18, plates=3, nchunk=50), mesh)
+
+
+def test_homogeneous_simple_shear_gives_the_shear_modulus(stack):
+    gamma = 1e-6
+    y = stack.mesh.coor[:, 1]
+    u = np.zeros(stack.model.ndof)
+    u[stack.mesh.dofs[:, 0]] = 2.0 * gamma * y
+    stack.restore(u, np.zeros(stack.mesh.nlayer), 0.0, 0.0)
+    stack.restore(u, stack.state.ubar.copy(), 0.0, 0.0)  # drive springs at rest
+    f = stack.state.f
+    # patch test: a homogeneous stress is in equilibrium at every interior node, transition rows included
+    top = stack.mesh.coor[:, 1] == stack.mesh.coor[:, 1].max()
+    interior = np.ones(stack.model.ndof, dtype=bool)
+    interior[stack.mesh.dofs[top].ravel()] = False
+    interior[stack.model.prescribed] = False
+    assert np.abs(f[interior]).max() < 1e-12 * np.abs(f).max()
+    # energy G eps_eq^2 V, eps_eq = gamma
+    volume = stack.model.layer_volume.sum()
+    assert 0.5 * u @ stack.state.f == pytest.approx(stack.params.G * gamma**2 * volume, rel=1e-10)
+    row = Observer(stack).observe(Observer(stack).well_index())
+    for layer in range(stack.mesh.nlayer):  # sigma_eq = 2 G gamma, eps_eq = gamma, in units 2 G eps0 and eps0
+        assert row[f"sigd_{layer}"] == pytest.approx(gamma / stack.params.eps0, rel=1e-10)
+        assert row[f"epsd_{layer}"] == pytest.approx(gamma / stack.params.eps0, rel=1e-10)
+        assert row[f"ubar_{layer}"] == pytest.approx(2 * gamma * stack.heights[layer], rel=1e-10)
+
+
+def test_uniaxial_strain_gives_bulk_and_shear_energy(stack):
+    eps = 1e-6
+    u = np.zeros(stack.model.ndof)
+    u[stack.mesh.dofs[:, 1]] = eps * stack.mesh.coor[:, 1]
+    stack.restore(u, np.zeros(stack.mesh.nlayer), 0.0, 0.0)
+    stack.restore(u, stack.state.ubar.copy(), 0.0, 0.0)
+    # eps_m = eps / 2, eps_eq = eps / 2: U = (K + G) eps^2 / 4
+    expected = (stack.params.K + stack.params.G) * eps**2 / 4 * stack.model.layer_volume.sum()
+    assert 0.5 * u @ stack.state.f == pytest.approx(expected, rel=1e-10)
+
+
+def _undamped_energy_error(system, dt, nsteps):
+    model = system.model._replace(damping=np.zeros(system.model.ndof), dt=dt,
+                                  drive_active=np.zeros_like(system.model.drive_active))
+    state = new_state(model)
+    x, y = system.mesh.coor[:, 0], system.mesh.coor[:, 1]
+    L, H = system.mesh.N * system.mesh.h, y.max()
+    state.u[system.mesh.dofs[:, 0]] = 1e-6 * np.sin(2 * np.pi * x / L) * np.sin(np.pi * y / H)
+    fe = np.zeros((model.iface_dofs.shape[0], 8))
+    compute_force(model, state, fe)
+    mass = np.where(model.mass_inv > 0, 1.0 / np.where(model.mass_inv > 0, model.mass_inv, 1.0), 0.0)
+    energies = []
+    for _ in range(nsteps):
+        time_step(model, state, fe)
+        energies.append(0.5 * mass @ state.v**2 + 0.5 * state.u @ state.f)
+    energies = np.array(energies)
+    return np.abs(energies - energies[0]).max() / energies[0]
+
+
+def test_undamped_dynamics_conserves_energy_to_second_order(stack):
+    dt = stack.model.dt
+    coarse = _undamped_energy_error(stack, dt, 1000)
+    fine = _undamped_energy_error(stack, dt / 2, 2000)
+    assert coarse < 1e-3
+    assert 3.0 < coarse / fine < 5.0  # O(dt^2)
+
+
+def _column_mesh(nx, ny, h):
+    """A periodic column of square elements, one elastic layer, no interface."""
+    x, y = np.meshgrid(np.arange(nx + 1) * h, np.arange(ny + 1) * h)
+    coor = np.column_stack([x.ravel(), y.ravel()])
+    node = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
+    conn = np.column_stack([node[:-1, :-1].ravel(), node[:-1, 1:].ravel(), node[1:, 1:].ravel(),
+                            node[1:, :-1].ravel()])
+    base = node.copy()
+    base[:, -1] = base[:, 0]
+    _, inverse = np.unique(base.ravel(), return_inverse=True)
+    dofs = np.column_stack([2 * inverse, 2 * inverse + 1])
+    iip = np.unique(np.concatenate([dofs[node[0]].ravel(), dofs[node[-1], 1]]))
+    return SimpleNamespace(coor=coor, conn=conn, dofs=dofs, iip=iip, elem_layer=np.zeros(len(conn), dtype=int),
+                           nlayer=1, layer_is_plastic=np.array([False]), layer_mid_height=np.array([ny * h / 2]),
+                           interface_elements=np.zeros((0, nx), dtype=int))
+
+
+def test_shear_pulse_travels_at_the_shear_wave_speed():
+    h, nx, ny = np.pi, 4, 400
+    mesh = _column_mesh(nx, ny, h)
+    model = build_model(mesh, epsy=np.zeros((0, 3)), K=4.5, G=1.0, rho=1.0, alpha=0.0, dt=0.05, k_drive=0.0,
+                        drive_active=np.array([False]), free_lever=False, lever_height=1.0)
+    c_s = math.sqrt(1.0 / 2.0 / 1.0)
+    state = new_state(model)
+    y = mesh.coor[:, 1]
+    y0, width = 100 * h, 12 * h
+    profile = np.exp(-(((y - y0) / width) ** 2))
+    state.u[mesh.dofs[:, 0]] = 1e-6 * profile
+    state.v[mesh.dofs[:, 0]] = 1e-6 * 2 * (y - y0) / width**2 * profile * c_s  # u(y - c_s t)
+    state.v[model.prescribed] = 0.0
+    fe = np.zeros((0, 8))
+    compute_force(model, state, fe)
+    column = mesh.dofs[mesh.coor[:, 0] == 0, 0]
+    ycol = y[mesh.coor[:, 0] == 0]
+
+    def centre():
+        w = state.u[column] ** 2
+        return (w * ycol).sum() / w.sum()
+
+    start = centre()
+    nsteps = 4000
+    for _ in range(nsteps):
+        time_step(model, state, fe)
+    speed = (centre() - start) / (nsteps * model.dt)
+    assert speed == pytest.approx(c_s, rel=0.01)
+
+
+def test_linear_response_and_load_step_superpose(stack):
+    s = stack
+    s.restore(np.zeros(s.model.ndof), np.zeros(s.mesh.nlayer), 0.0, 0.0)
+    s.compute_linear_response()
+    # the response is linear: forces scale with the displacement (interfaces in their first well)
+    s.restore(3.0 * s.delta_u, 3.0 * s.delta_target, 0.0, 0.0)
+    f3 = s.state.f.copy()
+    s.restore(s.delta_u, s.delta_target, 0.0, 0.0)
+    np.testing.assert_allclose(f3, 3.0 * s.state.f, rtol=0, atol=1e-12 * np.abs(f3).max())
+    # and it is in equilibrium with its drive (minimised to the residual tolerance)
+    free = ~s.model.prescribed
+    assert np.linalg.norm(s.state.f[free]) < 1e-3 * np.linalg.norm(s.state.f[~free])
+    # the load step superposes strain and stops just short of the first yield strain
+    s.restore(np.zeros(s.model.ndof), np.zeros(s.mesh.nlayer), 0.0, 0.0)
+    step = s.event_step(kick=False)
+    np.testing.assert_allclose(s.state.eps, step * s.delta_eps, rtol=0, atol=1e-12 * np.abs(s.state.eps).max())
+    eq = np.hypot(0.5 * (s.state.eps[..., 0] - s.state.eps[..., 1]), s.state.eps[..., 2])
+    ratio = eq / s.model.epsy[:, 1][:, None]
+    assert np.all(s.state.idx == 0)
+    assert 1.0 - 2e-5 < ratio.max() < 1.0
+    # a kick makes at least one Gauss point yield, and no more than a kick's worth of strain is added
+    before = s.state.idx.copy()
+    kick = step_size(s.model.epsy, s.model.iface_dofs, s.model.iface_dNdx, s.state.u, s.delta_u, s.state.eps,
+                     s.delta_eps, before, s.constants["deps"], True, False)
+    s.event_step(kick=True)
+    assert np.any(s.state.idx != before)
+    assert kick * equivalent_strain(*s.delta_eps.reshape(-1, 3).max(axis=0)) < 10 * s.constants["deps"]
