@@ -85,12 +85,12 @@ def run_simulation(params, output, mesh, threads=1):
     output = Path(output)
     if not output.exists():
         _create(output, params, mesh, threads)
-    with open_file(output, "r+") as file:
-        stored = read_params(file)
-        if params_to_dict(stored) != params_to_dict(params):
+    with open_file(output, "r") as file:  # read-only first: a completed file is not touched
+        if params_to_dict(read_params(file)) != params_to_dict(params):
             raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
         if bool(file.attrs["completed"]):
             return 0
+    with open_file(output, "r+") as file:
         truncate_to_stored(file)
         run = RunFile(file)
         system = System(params, run.mesh, threads=threads)
