@@ -8,7 +8,9 @@
 - ``S_a<a>``, ``A_a<a>``: signed number of well hops and number of blocks whose well
   changed since the previous increment, at Gauss point 0, interface ``a`` (1 = lowest);
 - ``gamma``: lever rotation ``90 - atan2(H_top, target_top)`` [deg] in units of
-  ``gamma0 = 90 - atan2(H_1, eps0 h)`` [deg].
+  ``gamma0 = 90 - atan2(H_1, eps0 h)`` [deg];
+- free lever only: ``lever_target`` (drive target ``x_target``) and ``lever_position``
+  (``x_lever``), displacements of the lever at the drive height ``H`` [length].
 """
 
 import math
@@ -60,9 +62,9 @@ def layer_strain_sums(u, edofs, dNdx, dV, elem_layer, nlayer):
     return out
 
 
-def observable_columns(nlayer, n_interfaces):
+def observable_columns(nlayer, n_interfaces, free_lever):
     """Names of the observable columns, in table order (after ``increment``, ``kick``, ``yield_element``)."""
-    names = ["t", "gamma", "epsd", "sigd"]
+    names = ["t", "gamma", "epsd", "sigd"] + (["lever_target", "lever_position"] if free_lever else [])
     for prefix in ("epsd", "sigd", "ubar", "fxdrive"):
         names += [f"{prefix}_{layer}" for layer in range(nlayer)]
     for prefix in ("S", "A"):
@@ -129,6 +131,9 @@ class Observer:
         total_sig = sig_sum.sum(axis=0) / self.volume.sum()
         row["epsd"] = equivalent_strain(*total_eps) / eps0
         row["sigd"] = equivalent_stress(*total_sig) / sig0
+        if model.free_lever:
+            row["lever_target"] = float(s.lever[0])
+            row["lever_position"] = float(s.lever[1])
         for layer in range(self.nlayer):
             row[f"epsd_{layer}"] = equivalent_strain(*(eps_sum[layer] / self.volume[layer])) / eps0
         for layer in range(self.nlayer):

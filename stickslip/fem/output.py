@@ -73,7 +73,8 @@ def create_file(file, system, observer):
     for name in ("lever_target", "t"):
         write_dataset(state, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
     table = file.create_group("increments")
-    columns = ["increment", "kick", "yield_element"] + observable_columns(observer.nlayer, observer.n_interfaces)
+    columns = ["increment", "kick", "yield_element"] + observable_columns(observer.nlayer, observer.n_interfaces,
+                                                                          system.model.free_lever)
     dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool}
     for name in columns:
         dtype = dtypes.get(name, np.int64 if name[:2] in ("S_", "A_") else np.float64)
@@ -171,7 +172,8 @@ def read_increments(path):
     pandas.DataFrame
         One row per stored increment; columns ``increment``, ``kick``, ``yield_element``, ``t``,
         ``gamma``, ``epsd``, ``sigd``, ``epsd_<l>``, ``sigd_<l>``, ``ubar_<l>``, ``fxdrive_<l>``,
-        ``S_a<a>``, ``A_a<a>`` (see :mod:`.observables`).
+        ``S_a<a>``, ``A_a<a>``; free lever also ``lever_target``, ``lever_position``
+        (see :mod:`.observables`).
     """
     with open_file(path) as file:
         read_params(file)
