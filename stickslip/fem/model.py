@@ -2,9 +2,8 @@
 
 Both are named tuples of numpy arrays and scalars so that the numba kernels of
 :mod:`.forces`, :mod:`.dynamics` and :mod:`.minimise` take them whole.
-Units: lengths in units of the block size's own unit (``h = pi``), stress in
-units of ``G``, time in units of ``h / (20 pi c) / dt``... i.e. the FE model's
-own units (``G = 1``, ``rho = 1``, shear-wave speed ``c_s = sqrt(G / 2 / rho)``).
+Units are the FE model's own: length (block size ``h = pi``), stress (``G = 1``),
+mass density (``rho = 1``), time (``dt = 0.05``; shear-wave speed ``c_s = sqrt(G / 2 / rho)``).
 """
 
 from collections import namedtuple
@@ -20,7 +19,7 @@ __all__ = ["Model", "State", "build_model", "new_state"]
 Model = namedtuple("Model", [
     "ndof",           # int: number of DOFs
     "dt",             # float: time step [time]
-    "k_ptr", "k_col", "k_val",  # CSR [ndof, ndof] elastic stiffness of the plates [stress]
+    "k_ptr", "k_col", "k_val",  # CSR [ndof, ndof] elastic stiffness of the plates [stress] (k_col int32)
     "mass_inv",       # float64 [ndof]: 1 / lumped mass on free DOFs, 0 on prescribed DOFs
     "damping",        # float64 [ndof]: lumped background damping [mass / time]
     "prescribed",     # bool [ndof]
@@ -100,6 +99,7 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
 
     k_ptr, k_col, k_val = assemble_csr(edofs[elastic], elastic_element_stiffness(dNdx[elastic], dV[elastic], K, G),
                                        ndof)
+    k_col = k_col.astype(np.int32)  # less memory traffic in the sparse product
     nelem = conn.shape[0]
     mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
     damping = lumped_diagonal(xe, edofs, np.full(nelem, alpha), ndof)
