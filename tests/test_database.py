@@ -5,6 +5,7 @@ import multiprocessing
 import sqlite3
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from stickslip.h5io import FileFormatError, open_file, read_table
@@ -125,3 +126,14 @@ def test_simulation_columns_fall_back_to_file_attributes(tmp_path):
     assert row == {"run_id": "0123456789abcdef", "solver": "fem", "path": "results/sim/fem/0123456789abcdef.h5",
                    "source": "numerical", "protocol": None, "n": 3, "a": None, "plates": 4, "blocks": 9,
                    "k_drive": 1e-6, "regime": "compliant", "seed": 2}
+
+
+def test_regime_stated_by_an_analysis_fills_its_simulation(toy_results):
+    record = read_record(toy_results[1])  # the analysis of the seed-1 run
+    with open_file(record["outputs"][0]["path"], "r+") as handle:
+        handle.attrs["regime"] = "compliant"
+    ingest("results/stickslip.sqlite", toy_results)
+    runs = query.runs("results/stickslip.sqlite", kind="solver")
+    regimes = dict(zip(runs["seed"], runs["regime"]))
+    assert regimes[1] == "compliant" and pd.isna(regimes[2])
+    assert len(query.events("results/stickslip.sqlite", regime="compliant")) == 4

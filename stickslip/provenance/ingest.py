@@ -46,6 +46,10 @@ EVENT_COLUMNS = {"event": "event", "a": "interface", "dR": "slip", "dmu": "dmu",
 SIMULATION_COLUMNS = {"protocol": ("protocol",), "n": ("n", "n_interfaces"), "a": ("a",), "plates": ("plates",),
                       "blocks": ("N",), "k_drive": ("k_drive",), "regime": ("regime",), "seed": ("seed",)}
 
+#: A simulation's driving regime, when its parameters do not state it, is the one its analysis
+#: output states (numerical-events: from k_drive); set once both records are in the same ingest.
+REGIME_FROM_ANALYSES = "UPDATE simulations SET regime = :regime WHERE run_id = :run_id AND regime IS NULL"
+
 #: An event's source is its simulation's (known once both records are in).
 SOURCE_FROM_SIMULATIONS = ("UPDATE slip_events SET source = (SELECT s.source FROM simulations AS s "
                            "WHERE s.run_id = slip_events.simulation_run_id) WHERE source IS NULL")
@@ -128,11 +132,13 @@ def _python(value):
 
 
 def _event_rows(record, record_file):
+    """Rows of ``slip_events`` from an analysis output, and the output's ``regime`` attribute (or None)."""
     output = _beside(record_file, record["outputs"][0]["path"])
     with open_file(output) as handle:
+        regime = _python(handle.attrs.get("regime"))
         name = next((table for table in EVENT_TABLES if table in handle), None)
         if name is None:
-            return []
+            return [], regime
         table = read_table(handle, name)
     if "single" in table.columns and "multi" not in table.columns:
         table["multi"] = ~table.pop("single").astype(bool)
@@ -150,7 +156,7 @@ def _event_rows(record, record_file):
             row["event"] = index
         row["extra"] = json.dumps({c: _python(item[c]) for c in extra_columns}) if extra_columns else None
         rows.append(row)
-    return rows
+    return rows, regime
 
 
 def _figure_row(record):
@@ -160,7 +166,13 @@ def _figure_row(record):
 
 
 def _ingest_record(session, record, record_file):
-    """Replace the rows of one run by those of its record; return the number of slip events added."""
+    """Replace the rows of one run by those of its record.
+
+    Returns
+    -------
+    tuple[int, dict[str, str]]
+        Slip events added; simulation run id -> driving regime stated by an analysis output.
+    """
     run_id = record["run_id"]
     for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (Artifact, Artifact.run_id),
                        (Simulation, Simulation.run_id), (Figure, Figure.run_id), (Run, Run.run_id)):
@@ -169,16 +181,18 @@ def _ingest_record(session, record, record_file):
     artifacts = _artifact_rows(record)
     if artifacts:
         session.execute(insert(Artifact), artifacts)
-    events = []
+    events, regimes = [], {}
     if record["kind"] == "solver":
         session.execute(insert(Simulation), [_simulation_row(record, record_file)])
     elif record["kind"] == "analysis":
-        events = _event_rows(record, record_file)
+        events, regime = _event_rows(record, record_file)
         if events:
             session.execute(insert(SlipEvent), events)
+        if regime is not None:
+            regimes[Path(record["inputs"][0]["path"]).stem] = regime
     elif record["kind"] == "figure":
         session.execute(insert(Figure), [_figure_row(record)])
-    return len(events)
+    return len(events), regimes
 
 
 def ingest(database, records, *, rebuild=False):
@@ -229,9 +243,15 @@ def ingest(database, records, *, rebuild=False):
                 create_schema(engine, __version__)
                 events = 0
                 with Session(engine) as session, session.begin():
+                    regimes = {}
                     for record_file in records:
-                        events += _ingest_record(session, read_record(record_file), record_file)
+                        added, found = _ingest_record(session, read_record(record_file), record_file)
+                        events += added
+                        regimes.update(found)
                     session.execute(text(SOURCE_FROM_SIMULATIONS))
+                    if regimes:
+                        session.execute(text(REGIME_FROM_ANALYSES),
+                                        [{"run_id": k, "regime": v} for k, v in regimes.items()])
             finally:
                 engine.dispose()
             os.replace(tmp, database)
