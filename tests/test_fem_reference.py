@@ -121,3 +121,31 @@ def test_cli_rejects_bad_parameters_naming_them(tmp_path, capsys):
     assert "'drive'" in error and "fixed-lever" in error and "free-lever" in error
     assert main(["simulate", "--solver", "fem", "--param", "Nx=9", "-o", str(tmp_path / "x.h5")]) == 2
     assert "'Nx'" in capsys.readouterr().err
+
+
+def test_results_do_not_depend_on_the_number_of_threads():
+    import numba
+
+    from stickslip.fem.dynamics import time_step
+    from stickslip.fem.system import System
+    from stickslip.mesh import MeshParams, build_stack_mesh
+    from stickslip.numba_options import set_num_threads
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba was started with one thread")
+    plugin = registry.get("solver", "fem")
+    params = parse_params(plugin.params, {**REFERENCE_CASE, "N": 18, "plates": 3})
+    mesh = build_stack_mesh(MeshParams(N=18, plates=3))
+    states = []
+    for threads in (1, 2):
+        set_num_threads(threads)
+        system = System(params, mesh, threads=threads)
+        system.compute_linear_response()
+        system.event_step(kick=False)
+        system.event_step(kick=True)
+        for _ in range(300):  # blocks yield during these steps
+            time_step(system.model, system.state, system._fe)
+        states.append(system.state)
+    set_num_threads(1)
+    for name in ("u", "v", "a", "f", "idx", "sig"):
+        np.testing.assert_array_equal(getattr(states[0], name), getattr(states[1], name), err_msg=name)
