@@ -174,6 +174,11 @@ def test_bad_tables_are_refused_with_the_column_named():
         ex.interfaces_in(table[["increment", "gamma"]])
 
 
-def test_driving_regime():
+def test_driving_regime_is_judged_at_the_paper_size():
     assert ex.driving_regime(1e-3) == "stiff"
     assert ex.driving_regime(1e-6) == "compliant"
+    assert ex.driving_regime(1e-3, 1458) == "stiff"
+    # plates N/3 blocks thick: Phi ~ k h_p^2 / G, so k = 1e-3 at N = 54 drives like 1.4e-6 at N = 1458
+    assert ex.paper_equivalent_stiffness(1e-3, 54) == pytest.approx(1e-3 / 27**2)
+    assert ex.driving_regime(1e-3, 54) == "compliant"
+    assert ex.driving_regime(1e-3 * 27**2, 54) == "stiff"

@@ -9,6 +9,7 @@ from stickslip.h5io import FileFormatError
 from test_events_extraction import EVENTS, N, history
 
 RUN_ATTRS = {"N": N, "plates": 3, "n_interfaces": 2, "k_drive": 1e-6, "seed": 4, "eps0": 5e-5, "c_s": 0.7071}
+STIFF = 1e-3 * (1458 / N) ** 2  # the paper's stiff driving, for N blocks
 
 
 def write(path, events=EVENTS, attrs=RUN_ATTRS):
@@ -55,8 +56,8 @@ def test_missing_run_attributes_are_named():
 
 def test_grouping_by_regime_and_n(tmp_path):
     write(tmp_path / "c.h5")
-    write(tmp_path / "s.h5", attrs={**RUN_ATTRS, "k_drive": 1e-3, "seed": 1})
-    write(tmp_path / "s2.h5", attrs={**RUN_ATTRS, "k_drive": 1e-3, "seed": 0})
+    write(tmp_path / "s.h5", attrs={**RUN_ATTRS, "k_drive": STIFF, "seed": 1})
+    write(tmp_path / "s2.h5", attrs={**RUN_ATTRS, "k_drive": STIFF, "seed": 0})
     files = [results.read_analysis_file(tmp_path / f, ("slips",)) for f in ("s.h5", "c.h5", "s2.h5")]
     groups = results.group_runs(files)
     assert list(groups) == [("compliant", 2), ("stiff", 2)]

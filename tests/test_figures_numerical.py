@@ -19,7 +19,7 @@ from test_events_extraction import history
 from test_fronts import C_S, H_BLOCK, SPACING, rupture
 
 N = 27
-K_DRIVE = {"stiff": 1e-3, "compliant": 1e-6}
+K_DRIVE = {"stiff": 1e-3 * (1458 / N) ** 2, "compliant": 1e-6 * (1458 / N) ** 2}  # the paper's, for N blocks
 
 
 def random_events(n, regime, rng, count=80):

@@ -105,6 +105,11 @@ def test_front_tables_rerun_the_steady_multi_slips(tmp_path):
     assert list(failures.columns) == ["increment", "a", "block", "t", "direction"]
     assert len(failures) == 2 * 2 * 2 * N
     assert failures.groupby("increment")["t"].apply(lambda t: t.is_monotonic_increasing).all()
+    # every slip event, single slips too
+    asked.clear()
+    fronts.front_tables(classified, rerun, N=N, h=H_BLOCK, c_s=C_S, spacing=SPACING,
+                        params=parse_params(fronts.FrontParams, {"events": "slip", "max_events": 3}))
+    assert asked == [8, 12, 14]
     # runs with another number of interfaces are not re-run
     asked.clear()
     params = parse_params(fronts.FrontParams, {"interfaces": 3})
@@ -119,5 +124,5 @@ def test_fit_window_must_not_be_empty():
 
 
 def test_interface_spacing_from_layer_heights():
-    assert fronts.interface_spacing({"layer_heights": [1.0, 3.0, 7.0, 11.0, 20.0]}) == 8.0
-    assert np.isnan(fronts.interface_spacing({"layer_heights": [1.0, 3.0, 7.0]}))
+    assert fronts.interface_spacing([1.0, 3.0, 7.0, 11.0, 20.0]) == 8.0
+    assert np.isnan(fronts.interface_spacing([1.0, 3.0, 7.0]))

@@ -28,6 +28,8 @@ from ..h5io import FileFormatError
 
 __all__ = [
     "STIFF_THRESHOLD",
+    "PAPER_N",
+    "paper_equivalent_stiffness",
     "driving_regime",
     "interfaces_in",
     "steady_state",
@@ -39,7 +41,11 @@ __all__ = [
     "sequence_fractions",
 ]
 
-#: Drive stiffness (per unit volume, FE units) separating "stiff" from "compliant" driving.
+#: Blocks per interface of the paper's simulations (2 x 3^6); plates are about N/3 blocks thick.
+PAPER_N = 1458
+
+#: Paper-equivalent drive stiffness (per unit volume, FE units) separating "stiff" from
+#: "compliant" driving; the paper uses 1e-3 (stiff) and 1e-6 (compliant) at N = 1458.
 STIFF_THRESHOLD = 1e-4
 
 #: Steady state: the secant modulus of the stress-strain curve has dropped below this
@@ -49,20 +55,49 @@ TANGENT_FRACTION = 0.95
 _S_COLUMN = re.compile(r"^S_a(\d+)$")
 
 
-def driving_regime(k_drive):
-    """Return ``"stiff"`` if ``k_drive >= 1e-4`` else ``"compliant"``.
+def paper_equivalent_stiffness(k_drive, N):
+    """The drive stiffness that gives the same driving regime in the paper's system size.
+
+    The regime is set by the ratio of the drive springs to the shear stiffness of the
+    plates, Phi ~ k_drive h_p^2 / G per unit interface length, with h_p the plate thickness
+    (a drive spring of stiffness k_drive per unit volume acts on a plate of area L h_p; the
+    plate and interface layer resist a relative displacement with G L / h_p). The mesh makes
+    h_p proportional to N (about N/3 blocks), so at N blocks per interface ``k_drive`` acts as
+    ``k_drive (N / 1458)^2`` would in the paper's N = 1458.
 
     Parameters
     ----------
     k_drive : float
-        Drive spring stiffness per unit volume [FE units]; the paper uses 1e-3 (stiff)
-        and 1e-6 (compliant).
+        Drive stiffness per unit volume [G / h^2, FE units].
+    N : int
+        Blocks per interface.
+
+    Returns
+    -------
+    float
+        ``k_drive * (N / 1458)**2`` [FE units].
+    """
+    return float(k_drive) * (float(N) / PAPER_N) ** 2
+
+
+def driving_regime(k_drive, N=PAPER_N):
+    """Return ``"stiff"`` or ``"compliant"`` driving.
+
+    Stiff if the paper-equivalent stiffness (:func:`paper_equivalent_stiffness`) is at least
+    1e-4, i.e. ``k_drive >= 1e-4`` at the paper's N = 1458 (it uses 1e-3 and 1e-6).
+
+    Parameters
+    ----------
+    k_drive : float
+        Drive spring stiffness per unit volume [FE units].
+    N : int, optional
+        Blocks per interface (default: the paper's 1458).
 
     Returns
     -------
     str
     """
-    return "stiff" if float(k_drive) >= STIFF_THRESHOLD else "compliant"
+    return "stiff" if paper_equivalent_stiffness(k_drive, N) >= STIFF_THRESHOLD else "compliant"
 
 
 def interfaces_in(increments):

@@ -16,7 +16,7 @@ for its event maps (appendix "Front dynamics -- numerics"). From the failures of
   interfaces (one plate plus one block layer).
 
 The ``front-dynamics`` analysis plugin applies this to the first ``max_events``
-steady-state multi-slip increments of a run.
+steady-state multi-slip increments of a run (or every slip event, ``events = "slip"``).
 """
 
 import dataclasses
@@ -26,6 +26,7 @@ import pandas as pd
 
 from .. import h5io
 from ..h5io import FileFormatError
+from ..mesh import load_mesh
 from ..params import ParameterError, param
 from ..registry import register
 from . import extraction
@@ -158,43 +159,41 @@ def analyse_event(failures, N, *, h, c_s, spacing, fit_from=0.3, fit_to=0.9):
     return row
 
 
-def multi_slip_increments(classified, max_events):
-    """The first ``max_events`` steady-state multi-slip increments of a classified run.
+def multi_slip_increments(classified, max_events, kinds=("multi",)):
+    """The first ``max_events`` steady-state slip increments of the given kinds.
 
     Parameters
     ----------
     classified : pandas.DataFrame
         Output of :func:`stickslip.events.extraction.classify_increments`.
     max_events : int
+    kinds : tuple[str, ...], optional
+        Event kinds: ("multi",) (default) or ("single", "multi").
 
     Returns
     -------
     numpy.ndarray
         Increment numbers, ascending.
     """
-    chosen = classified["steady"].to_numpy(dtype=bool) & (classified["kind"].to_numpy() == "multi")
+    chosen = classified["steady"].to_numpy(dtype=bool) & classified["kind"].isin(kinds).to_numpy()
     return classified["increment"].to_numpy()[chosen][:max_events]
 
 
-def interface_spacing(attrs, *, source="run"):
-    """Distance H between the mid-lines of adjacent interfaces, from the run's layer heights.
+def interface_spacing(layer_heights):
+    """Distance H between the mid-lines of adjacent interfaces.
 
     Parameters
     ----------
-    attrs : Mapping[str, object]
-        Run attributes with ``layer_heights``: mid-height of every layer l = 0 ... 2n
-        (l = 2i plate i, l = 2a - 1 interface a) [FE length].
-    source : str, optional
-        Origin of the attributes, for error messages.
+    layer_heights : array_like
+        Mid-height of every layer l = 0 ... 2n (l = 2i plate i, l = 2a - 1 interface a),
+        shape [2n + 1] [FE length].
 
     Returns
     -------
     float
         ``layer_heights[3] - layer_heights[1]`` [FE length]; NaN with a single interface.
     """
-    if "layer_heights" not in attrs:
-        raise FileFormatError(f"{source}: run attributes lack 'layer_heights' (mid-height of every layer)")
-    heights = np.asarray(attrs["layer_heights"], dtype=float)
+    heights = np.asarray(layer_heights, dtype=float)
     return float(heights[3] - heights[1]) if heights.size >= 4 else np.nan
 
 
@@ -203,6 +202,8 @@ class FrontParams:
     """Parameters of the front-dynamics analysis."""
 
     max_events: int = param(10, "steady-state multi-slip increments re-run per fem run (the first ones)", minimum=1)
+    events: str = param("multi", "which steady-state slip events are re-run: multi-slips (the paper) or every "
+                                 "slip (front speed from single slips too)", choices=("multi", "slip"))
     interfaces: int = param(2, "re-run events only in runs with this many interfaces (the paper: 2; 0: every "
                                "run); the output of other runs has empty tables", minimum=0)
     fit_from: float = param(0.3, "front fit: smallest distance from the nucleation block, fraction of half the "
@@ -229,8 +230,8 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
     N, h, c_s, spacing
         See :func:`analyse_event`.
     params : FrontParams
-        ``max_events``, ``interfaces`` (runs with another number of interfaces give empty
-        tables), ``fit_from``, ``fit_to``.
+        ``max_events``, ``events`` ("multi" or "slip"), ``interfaces`` (runs with another
+        number of interfaces give empty tables), ``fit_from``, ``fit_to``.
 
     Returns
     -------
@@ -240,7 +241,8 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
     """
     failures, fronts = [], []
     n = len(extraction.interfaces_in(classified))
-    chosen = multi_slip_increments(classified, params.max_events) if params.interfaces in (0, n) else []
+    kinds = ("multi",) if params.events == "multi" else ("single", "multi")
+    chosen = multi_slip_increments(classified, params.max_events, kinds) if params.interfaces in (0, n) else []
     for increment in chosen:
         events = rerun(int(increment))
         _check_failures(events, f"re-run of increment {increment}")
@@ -281,7 +283,8 @@ def run(params, input, output):
         if key not in run_attrs:
             raise FileFormatError(f"{input}: run attributes lack {key}")
     N = int(run_attrs["N"])
-    spacing = interface_spacing(run_attrs, source=str(input))
+    with h5io.open_file(input) as file:
+        spacing = interface_spacing(load_mesh(file["mesh"]).layer_mid_height)
     classified = extraction.classify_increments(read_increments(input), N, source=str(input))
     failures, fronts = front_tables(classified, lambda increment: rerun_with_failures(input, increment), N=N,
                                     h=float(run_attrs["h"]), c_s=float(run_attrs["c_s"]), spacing=spacing,

@@ -12,7 +12,9 @@ Output file (HDF5, tables as in :func:`stickslip.h5io.write_table`):
     runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`).
 
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
-plus ``regime`` ("stiff" or "compliant"), ``steady_state`` (first steady-state increment,
+plus ``k_equivalent`` (the paper-equivalent drive stiffness,
+:func:`~stickslip.events.extraction.paper_equivalent_stiffness`), ``regime`` ("stiff" or
+"compliant", from ``k_equivalent``), ``steady_state`` (first steady-state increment,
 -1 if not reached), ``analysis`` and ``analysis_version``.
 """
 
@@ -82,7 +84,8 @@ def event_attrs(run_attrs, classified, *, source="run"):
         raise FileFormatError(f"{source}: run attributes lack {', '.join(missing)}")
     attrs = dict(run_attrs)
     attrs["n_interfaces"] = int(run_attrs["plates"]) - 1
-    attrs["regime"] = extraction.driving_regime(run_attrs["k_drive"])
+    attrs["k_equivalent"] = extraction.paper_equivalent_stiffness(run_attrs["k_drive"], run_attrs["N"])
+    attrs["regime"] = extraction.driving_regime(run_attrs["k_drive"], run_attrs["N"])
     steady = classified["increment"][classified["steady"]]
     attrs["steady_state"] = int(steady.iloc[0]) if steady.size else -1
     return attrs

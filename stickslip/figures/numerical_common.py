@@ -13,7 +13,7 @@ __all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "read_inputs", "density", "plot_d
 #: The paper's convention: stiff driving dashed, compliant solid.
 REGIME_LINESTYLE = {"stiff": "--", "compliant": "-"}
 
-REGIME_LABEL = {"stiff": r"stiff driving ($K = 10^{-3}$)", "compliant": r"compliant driving ($K = 10^{-6}$)"}
+REGIME_LABEL = {"stiff": "stiff driving", "compliant": "compliant driving"}
 
 
 def read_inputs(inputs, category, tables, figure):
