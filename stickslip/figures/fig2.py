@@ -55,6 +55,8 @@ def plot_stress_trace(ax, increments, N, slips_shown):
     steady = increments[increments["steady"].to_numpy(dtype=bool)]
     if steady.empty:
         ax.text(0.5, 0.5, "steady state not reached", transform=ax.transAxes, ha="center")
+        ax.set_xticks([])
+        ax.set_yticks([])
         return 0
     slip_rows = np.flatnonzero(steady["kind"].isin(("single", "multi")).to_numpy())
     end = slip_rows[slips_shown - 1] + 1 if slip_rows.size >= slips_shown else len(steady)
@@ -83,6 +85,8 @@ def _trace_panel(ax, groups, regime, n, slips_shown):
     ax.set_title(f"{regime}, $n = {n}$", fontsize=9)
     if not files:
         ax.text(0.5, 0.5, f"no {regime} run with n = {n}", transform=ax.transAxes, ha="center")
+        ax.set_xticks([])
+        ax.set_yticks([])
         return
     run_file = files[0]
     increments = run_file.tables["increments"]
