@@ -11,7 +11,6 @@ import dataclasses
 
 import numpy as np
 
-from ..h5io import FileFormatError
 from ..params import param
 from ..registry import register
 from .numerical_common import read_inputs
@@ -30,9 +29,9 @@ class EventMapParams:
     """Which events to draw."""
 
     n: int = param(2, "interfaces of the runs used (the paper: 2)", minimum=2)
-    events: tuple[int, ...] = param((0, 1), "which re-run multi-slip events to draw: indices in the list of "
-                                            "events with two slipping interfaces, ordered by (regime, N, seed, "
-                                            "increment)", minimum=0)
+    events: tuple[int, ...] = param((0, 1), "which re-run events to draw: indices in the list of re-run events "
+                                            "of the runs with n interfaces, multi-slips first, then by (regime, "
+                                            "N, seed, increment)", minimum=0)
 
 
 def front_lines(nucleation, speed, t0, t_end, N, points=200):
@@ -67,14 +66,14 @@ def front_lines(nucleation, speed, t0, t_end, N, points=200):
 
 
 def _events(files, n):
+    """Re-run events of the runs with ``n`` interfaces: multi-slips first (the paper's), then single slips."""
     chosen = []
     for item in sorted(files, key=lambda f: (f.regime, f.attrs.get("N", 0), f.attrs.get("seed", 0), f.path)):
         if item.n != n:
             continue
-        fronts = item.tables["fronts"]
-        for _, front in fronts[fronts["s"].to_numpy() >= 2].iterrows():
+        for _, front in item.tables["fronts"].iterrows():
             chosen.append((item, front))
-    return chosen
+    return sorted(chosen, key=lambda event: -int(event[1]["s"]))
 
 
 def _event_map(axes, item, front):
@@ -98,7 +97,8 @@ def _event_map(axes, item, front):
                     va="top", color=FIT_COLOR, fontsize=7)
         ax.set_xlim(0, N)
         ax.set_ylabel(f"$i = {a}$\n" + r"$t c_s / H$", fontsize=8)
-    axes[0].set_title(f"{item.regime}, $N = {N}$, seed {item.attrs.get('seed', '?')}, "
+    kind = "multi-slip" if front["s"] >= 2 else "single slip (no multi-slip re-run available)"
+    axes[0].set_title(f"{kind}: {item.regime}, $N = {N}$, seed {item.attrs.get('seed', '?')}, "
                       f"increment {int(front['increment'])}", fontsize=7)
     axes[1].set_xlabel(r"$r / \ell_0$")
 
@@ -107,14 +107,14 @@ def _event_map(axes, item, front):
 def run(params, inputs, output):
     """SI: event maps (failure position against time) of two multi-slip events, n = 2."""
     events = _events(read_inputs(inputs, "analysis:front-dynamics", ("failures", "fronts"), NAME), params.n)
-    missing = [k for k in params.events if k >= len(events)]
-    if missing:
-        raise FileFormatError(f"figure '{NAME}': asked for event(s) {missing} but the inputs hold "
-                              f"{len(events)} re-run event(s) with two slipping interfaces and n = {params.n}")
     fig = plt.figure(figsize=(3.5 * len(params.events), 4.0), constrained_layout=True)
     panels = fig.subfigures(1, len(params.events), squeeze=False)[0]
     for panel, index, letter in zip(panels, params.events, "abcdefgh"):
         axes = panel.subplots(2, 1, sharex=True, sharey=True)
-        _event_map(axes, *events[index])
+        if index < len(events):
+            _event_map(axes, *events[index])
+        else:
+            axes[0].set_title(f"event {index}: the inputs hold {len(events)} re-run event(s) with n = {params.n}",
+                              fontsize=7)
         panel.suptitle(f"({letter})", x=0.05, ha="left", fontweight="bold", fontsize=9)
     save_figure(fig, output)
