@@ -2,7 +2,7 @@
 
 Every block failure of a re-run event: position r / l0 (block index) against the time since
 the first failure anywhere, in units of H/c_s (H the distance between adjacent interfaces).
-One panel per event, with the two interfaces above each other (interface 2 on top); failures
+One panel per event, with the interfaces above each other (the highest on top); failures
 in the direction of the applied shear black, backwards blue. The fitted ballistic front of
 the first slipping interface (speed c_f, in the text) is drawn in red.
 """
@@ -83,7 +83,7 @@ def _event_map(axes, item, front):
     failures = item.tables["failures"]
     failures = failures[failures["increment"].to_numpy() == front["increment"]]
     t0 = failures["t"].min()
-    for ax, a in zip(axes, (2, 1)):
+    for ax, a in zip(axes, range(len(axes), 0, -1)):
         sub = failures[failures["a"].to_numpy() == a]
         for direction, color in ((1, FORWARD_COLOR), (-1, BACKWARD_COLOR)):
             part = sub[sub["direction"].to_numpy() == direction]
@@ -97,10 +97,10 @@ def _event_map(axes, item, front):
                     va="top", color=FIT_COLOR, fontsize=7)
         ax.set_xlim(0, N)
         ax.set_ylabel(f"$i = {a}$\n" + r"$t c_s / H$", fontsize=8)
-    kind = "multi-slip" if front["s"] >= 2 else "single slip (no multi-slip re-run available)"
-    axes[0].set_title(f"{kind}: {item.regime}, $N = {N}$, seed {item.attrs.get('seed', '?')}, "
+    kind = "multi-slip" if front["s"] >= 2 else "single slip (no multi-slip re-run)"
+    axes[0].set_title(f"{kind}\n{item.regime}, $N = {N}$, seed {item.attrs.get('seed', '?')}, "
                       f"increment {int(front['increment'])}", fontsize=7)
-    axes[1].set_xlabel(r"$r / \ell_0$")
+    axes[-1].set_xlabel(r"$r / \ell_0$")
 
 
 @register("figure", NAME, "1", EventMapParams, inputs=("analysis:front-dynamics",))
@@ -110,7 +110,7 @@ def run(params, inputs, output):
     fig = plt.figure(figsize=(3.5 * len(params.events), 4.0), constrained_layout=True)
     panels = fig.subfigures(1, len(params.events), squeeze=False)[0]
     for panel, index, letter in zip(panels, params.events, "abcdefgh"):
-        axes = panel.subplots(2, 1, sharex=True, sharey=True)
+        axes = panel.subplots(params.n, 1, sharex=True, sharey=True)
         if index < len(events):
             _event_map(axes, *events[index])
         else:
