@@ -27,7 +27,8 @@ from .params import params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import recording, sha256_file
 
-__all__ = ["prepare_environment", "run_mesh", "run_simulation", "run_analysis", "run_figure", "build_database"]
+__all__ = ["prepare_environment", "partial_path", "run_mesh", "run_simulation", "run_analysis", "run_figure",
+           "build_database"]
 
 
 def prepare_environment(threads, numba_cache=""):
@@ -165,7 +166,34 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         with _plugin_recording(record, [("output", output)], plugin, params, registry.run_id(plugin, params),
                                threads=used, inputs=sorted(inputs.items())) as job:
             print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(job['params'])}")
-            plugin.run(params, Path(output), threads=used, inputs={k: Path(v) for k, v in inputs.items()})
+            partial = partial_path(output)
+            partial.parent.mkdir(parents=True, exist_ok=True)
+            if partial.exists():
+                print(f"resuming from {partial}")
+            plugin.run(params, partial, threads=used, inputs={k: Path(v) for k, v in inputs.items()})
+            os.replace(partial, output)
+
+
+def partial_path(output):
+    """Where a simulation is written until it completes: ``<dir>/partial/<name>``.
+
+    Snakemake deletes the output of a job that fails or is killed (a cluster's wall
+    time, Ctrl-C). A solver that stores its progress as it goes (``fem`` appends every
+    increment) writes here instead, outside Snakemake's outputs, and the finished
+    file is renamed to ``output``; the rerun of an interrupted job resumes from it.
+
+    Parameters
+    ----------
+    output : str or pathlib.Path
+        The simulation file of the rule, ``results/sim/{solver}/{run_id}.h5``.
+
+    Returns
+    -------
+    pathlib.Path
+        ``results/sim/{solver}/partial/{run_id}.h5``.
+    """
+    output = Path(output)
+    return output.parent / "partial" / output.name
 
 
 def run_analysis(analysis, params_json, input, output, record, log, *, numba_cache=""):
