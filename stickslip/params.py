@@ -19,7 +19,7 @@ conditions that involve several fields; it raises :class:`ParameterError`.
 import dataclasses
 import math
 import typing
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 
 __all__ = [
     "ParameterError",

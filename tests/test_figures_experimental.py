@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from stickslip import registry
-from stickslip.figures import experimental_data
+from stickslip.figures import experimental_data, plotting
 from stickslip.figures.experimental_panels import linear_edges, log_edges
 from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
@@ -18,12 +18,12 @@ def test_density_is_normalised_on_linear_and_logarithmic_bins():
     rng = np.random.default_rng(0)
     values = rng.lognormal(3.0, 1.0, 5000)
     for edges in (linear_edges(values, 40), log_edges(values, 10)):
-        centres, pdf = experimental_data.density(values, edges)
+        centres, pdf = plotting.density(values, edges)
         inside = np.count_nonzero((values >= edges[0]) & (values <= edges[-1])) / values.size
         assert np.nansum(pdf * np.diff(edges)) == pytest.approx(inside)
         assert np.all((centres > edges[:-1]) & (centres < edges[1:]))
     # Logarithmic edges have geometric centres.
-    centres, _ = experimental_data.density([2.0, 20.0], np.array([1.0, 10.0, 100.0]))
+    centres, _ = plotting.density([2.0, 20.0], np.array([1.0, 10.0, 100.0]))
     np.testing.assert_allclose(centres, [np.sqrt(10.0), np.sqrt(1000.0)])
 
 

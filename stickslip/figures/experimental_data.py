@@ -1,5 +1,5 @@
 """What the experimental figures share: reading ``experiment-events`` files, finding the
-time series a table came from, probability densities, and the style of ``n`` and ``a``.
+time series a table came from, and the time excerpts of panels.
 
 Every figure receives lists of paths and groups runs by the attributes stored in the files:
 ``n`` (driven slabs), ``protocol`` ("stack" or "individual") and ``a`` (slab driven alone).
@@ -8,15 +8,12 @@ Every figure receives lists of paths and groups runs by the attributes stored in
 import hashlib
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from .. import h5io
 from ..experiment.timeseries import read_timeseries
-from .style import N_MARKERS, interface_color, n_color
 
-__all__ = ["EVENTS", "LEVER", "load_slips", "load_interfaces", "example_run", "excerpt", "density", "plot_density",
-           "n_style", "individual_style", "a_style", "label_panels"]
+__all__ = ["EVENTS", "LEVER", "load_slips", "load_interfaces", "example_run", "excerpt"]
 
 #: Input categories of the experimental figures.
 EVENTS = "analysis:experiment-events"
@@ -123,85 +120,3 @@ def excerpt(record, t_from, duration):
     record if it is shorter."""
     end = min(t_from + duration, record.t_x[-1])
     return (max(record.t_x[0], end - duration), end)
-
-
-def density(values, edges):
-    """Probability density of ``values`` on the bins ``edges``.
-
-    Parameters
-    ----------
-    values : array_like
-        NaN entries are ignored.
-    edges : numpy.ndarray, shape (m + 1,)
-
-    Returns
-    -------
-    centres : numpy.ndarray, shape (m,)
-        Bin centres (geometric centres if the edges are logarithmic, i.e. all > 0 and of constant
-        ratio).
-    pdf : numpy.ndarray, shape (m,)
-        ``count / (total * width)``, NaN where the bin is empty (so that lines skip it).
-    """
-    values = np.asarray(values, dtype=float)
-    values = values[np.isfinite(values)]
-    counts, _ = np.histogram(values, edges)
-    widths = np.diff(edges)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        pdf = counts / (max(values.size, 1) * widths)
-    ratio = edges[1:] / edges[:-1] if np.all(edges > 0) else None
-    logarithmic = ratio is not None and np.allclose(ratio, ratio[0])
-    centres = np.sqrt(edges[1:] * edges[:-1]) if logarithmic else 0.5 * (edges[1:] + edges[:-1])
-    return centres, np.where(counts > 0, pdf, np.nan)
-
-
-def plot_density(ax, values, edges, *, logarithmic=False, **style):
-    """Draw ``P(values)`` on ``ax`` as a line with markers.
-
-    Parameters
-    ----------
-    ax : matplotlib.axes.Axes
-    values : array_like
-    edges : numpy.ndarray
-        Bin edges, in units of ``values``.
-    logarithmic : bool
-        Draw the density of ``log10(values)`` (per decade) at the bin centres, for an axis in
-        logarithmic scale; ``edges`` must then be positive.
-    **style
-        Forwarded to :meth:`matplotlib.axes.Axes.plot`.
-
-    Returns
-    -------
-    matplotlib.lines.Line2D or None
-        None if there is no finite value.
-    """
-    values = np.asarray(values, dtype=float)
-    if not np.isfinite(values).any():
-        return None
-    if logarithmic:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            centres, pdf = density(np.log10(values), np.log10(edges))
-        centres = 10.0 ** centres
-    else:
-        centres, pdf = density(values, edges)
-    return ax.plot(centres, pdf, markersize=3.5, linewidth=1.0, **style)[0]
-
-
-def n_style(n):
-    """Colour, marker and label of a stack of ``n`` driven slabs."""
-    return {"color": n_color(n), "marker": N_MARKERS[(int(n) - 1) % len(N_MARKERS)], "label": f"$n = {int(n)}$"}
-
-
-def individual_style():
-    """Style of an interface driven alone (the paper's black ``n = 1`` reference)."""
-    return {"color": "black", "marker": "o", "label": "$n = 1$ (individual)"}
-
-
-def a_style(a):
-    """Colour, marker and label of interface ``a``."""
-    return {"color": interface_color(a), "marker": N_MARKERS[(int(a) - 1) % len(N_MARKERS)], "label": f"$a = {int(a)}$"}
-
-
-def label_panels(axes):
-    """Write (a), (b), ... above the top-left corner of each axis."""
-    for letter, ax in zip("abcdefghijklmnopqrstuvwxyz", np.ravel(axes)):
-        ax.set_title(f"({letter})", loc="left", fontsize=9)

@@ -10,7 +10,7 @@ import numpy as np
 from matplotlib.ticker import NullFormatter
 
 from ..experiment import aging, kinematics
-from .experimental_data import a_style, individual_style, n_style, plot_density
+from .plotting import a_style, individual_style, n_style, plot_density
 from .style import interface_color
 
 __all__ = ["LABELS", "single_slips", "linear_edges", "log_edges", "distributions_by_n", "aging_panel",

@@ -17,7 +17,8 @@ from ..events.extraction import interfaces_in, slip_fractions
 from ..events.results import group_runs, pooled
 from ..params import param
 from ..registry import register
-from .numerical_common import REGIME_LINESTYLE, n_style, panel_label, plot_density, read_inputs
+from .numerical_common import REGIME_LINESTYLE, read_inputs
+from .plotting import label_panels, n_style, plot_density, range_edges
 from .style import interface_color, plt, save_figure
 
 __all__ = ["Fig2Params", "plot_stress_trace", "run"]
@@ -107,7 +108,7 @@ def _rho_panel(ax, groups):
             continue
         rho = slip_fractions(slips, n)
         ax.plot(np.arange(1, n + 1), rho, ls=REGIME_LINESTYLE[regime], markersize=4,
-                markerfacecolor="white" if regime == "stiff" else None, **n_style(n))
+                markerfacecolor="white" if regime == "stiff" else None, **{**n_style(n), "label": None})
     ax.set_xlabel("$s$")
     ax.set_ylabel(r"$\rho(s)$")
     ax.set_ylim(-0.02, 1.02)
@@ -125,7 +126,7 @@ def _drop_panel(ax, groups, bins):
         if per.empty:
             continue
         dmu = per["dmu"].to_numpy()[per["single"].to_numpy(dtype=bool)]
-        plot_density(ax, dmu, bins, label=f"$n = {n}$ ({dmu.size})", **n_style(n))
+        plot_density(ax, dmu, range_edges(dmu, bins), **{**n_style(n), "label": f"$n = {n}$ ({dmu.size})"})
     ax.set_xlabel(r"$\Delta\mu_a / \sigma_0$")
     ax.set_ylabel(r"$P(\Delta\mu_a)$")
     ax.set_title("compliant, single slips", fontsize=9)
@@ -142,6 +143,5 @@ def run(params, inputs, output):
     _trace_panel(axes[0, 1], groups, "compliant", params.n_trace, params.slips_shown)
     _rho_panel(axes[1, 0], groups)
     _drop_panel(axes[1, 1], groups, params.bins)
-    for ax, letter in zip(axes.flat, "abcf"):
-        panel_label(ax, letter)
+    label_panels(axes, "abcf")
     save_figure(fig, output)

@@ -8,7 +8,8 @@ from matplotlib.ticker import NullFormatter
 
 from .. import registry
 from ..params import param
-from .experimental_data import EVENTS, LEVER, a_style, example_run, excerpt, label_panels, load_slips
+from .experimental_data import EVENTS, LEVER, example_run, excerpt, load_slips
+from .plotting import a_style, label_panels
 from .experimental_panels import LABELS, distributions_by_n, linear_edges, positions_panel, single_slips
 from .style import interface_color, plt, save_figure
 

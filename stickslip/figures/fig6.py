@@ -8,7 +8,8 @@ import numpy as np
 from .. import registry
 from ..experiment.aging import spread_of_aging_rate
 from ..params import param
-from .experimental_data import EVENTS, LEVER, a_style, example_run, label_panels, load_interfaces, load_slips
+from .experimental_data import EVENTS, LEVER, example_run, load_interfaces, load_slips
+from .plotting import a_style, label_panels
 from .experimental_panels import distributions_by_n, linear_edges, single_slips, slow_slip_fraction_panel
 from .style import interface_color, plt, save_figure
 

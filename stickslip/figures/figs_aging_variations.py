@@ -6,7 +6,8 @@ import dataclasses
 from .. import registry
 from ..experiment.aging import without_slow_slip
 from ..params import param
-from .experimental_data import EVENTS, individual_style, label_panels, load_slips
+from .experimental_data import EVENTS, load_slips
+from .plotting import individual_style, label_panels
 from .experimental_panels import aging_panel, disorder_law_lines, single_slips
 from .style import plt, save_figure
 

@@ -12,7 +12,8 @@ import numpy as np
 from ..events.results import group_runs, pooled
 from ..params import param
 from ..registry import register
-from .numerical_common import REGIME_LABEL, n_style, panel_label, plot_density, read_inputs
+from .numerical_common import REGIME_LABEL, read_inputs
+from .plotting import label_panels, n_style, plot_density, range_edges
 from .style import plt, save_figure
 
 __all__ = ["DgammaParams", "run"]
@@ -33,17 +34,18 @@ def run(params, inputs, output):
     """SI: P(Delta gamma_a) between slips of interface a = 1, for every n, stiff and compliant."""
     groups = group_runs(read_inputs(inputs, "analysis:numerical-events", ("slip_interfaces",), NAME))
     fig, axes = plt.subplots(1, 2, figsize=(7.0, 2.8), constrained_layout=True)
-    for ax, regime, letter in zip(axes, ("stiff", "compliant"), "ab"):
+    for ax, regime in zip(axes, ("stiff", "compliant")):
         for (group_regime, n), files in groups.items():
             per = pooled(files, "slip_interfaces")
             if group_regime != regime or per.empty or n < params.interface:
                 continue
             dgamma = per["dgamma"].to_numpy()[per["a"].to_numpy() == params.interface]
             dgamma = dgamma[np.isfinite(dgamma)]  # the first slip of each run has no predecessor (NaN)
-            plot_density(ax, dgamma, params.bins, label=f"$n = {n}$ ({dgamma.size})", **n_style(n))
+            plot_density(ax, dgamma, range_edges(dgamma, params.bins),
+                         **{**n_style(n), "label": f"$n = {n}$ ({dgamma.size})"})
         ax.set_xlabel(rf"$\Delta\gamma_{{{params.interface}}} / \gamma_0$")
         ax.set_ylabel(rf"$P(\Delta\gamma_{{{params.interface}}})$")
         ax.set_title(REGIME_LABEL[regime], fontsize=9)
         ax.legend(fontsize=7, frameon=False, title="(intervals)", title_fontsize=6)
-        panel_label(ax, letter)
+    label_panels(axes)
     save_figure(fig, output)

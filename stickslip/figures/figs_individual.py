@@ -8,7 +8,8 @@ from matplotlib.ticker import NullFormatter
 
 from .. import registry
 from ..params import param
-from .experimental_data import EVENTS, a_style, label_panels, load_slips, plot_density
+from .experimental_data import EVENTS, load_slips
+from .plotting import a_style, label_panels, plot_density
 from .experimental_panels import LABELS, linear_edges, single_slips
 from .style import plt, save_figure
 

@@ -13,7 +13,8 @@ import numpy as np
 from ..events.extraction import sequence_fractions
 from ..events.results import group_runs, pooled
 from ..registry import register
-from .numerical_common import REGIME_LABEL, panel_label, read_inputs
+from .numerical_common import REGIME_LABEL, read_inputs
+from .plotting import label_panels
 from .style import plt, save_figure
 
 __all__ = ["SequencesParams", "fractions_by_n", "run"]
@@ -59,7 +60,7 @@ def run(params, inputs, output):
     """SI: fraction of slip events in single- or multi-slip sequences against n, stiff and compliant."""
     groups = group_runs(read_inputs(inputs, "analysis:numerical-events", ("sequences",), NAME))
     fig, axes = plt.subplots(1, 2, figsize=(7.0, 2.8), constrained_layout=True, sharey=True)
-    for ax, regime, letter in zip(axes, ("stiff", "compliant"), "ab"):
+    for ax, regime in zip(axes, ("stiff", "compliant")):
         n, single, any_ = fractions_by_n(groups, regime)
         ax.fill_between(n, 0, single, color=SINGLE_COLOR, alpha=0.2, lw=0)
         ax.fill_between(n, single, any_, color=ANY_COLOR, alpha=0.25, lw=0, label="in multi-slip sequences")
@@ -69,7 +70,7 @@ def run(params, inputs, output):
         ax.set_ylim(0, 1.02)
         ax.xaxis.get_major_locator().set_params(integer=True)
         ax.set_title(REGIME_LABEL[regime], fontsize=9)
-        panel_label(ax, letter)
+    label_panels(axes)
     axes[0].set_ylabel("fraction of slip events")
     axes[1].legend(fontsize=7, frameon=False, loc="lower left")
     save_figure(fig, output)

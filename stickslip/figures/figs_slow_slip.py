@@ -8,7 +8,8 @@ import numpy as np
 from .. import registry
 from ..experiment import detection
 from ..params import param
-from .experimental_data import EVENTS, LEVER, example_run, excerpt, label_panels, load_interfaces, load_slips
+from .experimental_data import EVENTS, LEVER, example_run, excerpt, load_interfaces, load_slips
+from .plotting import label_panels
 from .experimental_panels import positions_panel, slow_slip_fraction_panel
 from .style import interface_color, plt, save_figure
 

@@ -26,7 +26,7 @@ from pathlib import Path
 from sqlalchemy import delete, insert, text
 from sqlalchemy.orm import Session
 
-from ..h5io import FileFormatError, open_file, read_table
+from ..h5io import open_file, read_table
 from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
 

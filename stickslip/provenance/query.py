@@ -12,7 +12,7 @@ import sqlalchemy.exc
 from sqlalchemy import select, text
 
 from ..h5io import FileFormatError
-from .database import Figure, Run, Simulation, SlipEvent, engine_for
+from .database import Figure, Run, Simulation, engine_for
 
 __all__ = ["DEFAULT_DATABASE", "QueryError", "runs", "events", "figures", "sql"]
 
