@@ -1,15 +1,28 @@
-"""Benchmark of the fem solver: time per time step (after a kick, blocks yielding), or one whole event.
+"""Benchmark of the fem solver: time per time step, consecutive events with both relaxations, linear response.
 
 Usage::
 
     python benchmarks/bench_fem.py --N 1458 --plates 2 --threads 1 --steps 2000
-    python benchmarks/bench_fem.py --N 162 --plates 2 --threads 1 --event
+    python benchmarks/bench_fem.py --N 162 --plates 3 --event --events 100 --k_drive 0.081
+    python benchmarks/bench_fem.py --N 1458 --plates 6 --linear-response
 
-The last line printed is ``time_per_step_us=<value>`` (with ``--event`` also the
-number of steps and the seconds of the event: load step + kick + minimisation).
-Compilation is excluded (warm-up first); numba's cache makes later runs start fast. The
-per-step mode loads along an affine shear instead of the (costly, minutes for N = 1458)
-linear response: the cost of a step does not depend on it.
+Per-step mode: time steps right after a kick (blocks yielding); last line
+``time_per_step_us=<value>``. It loads along an affine shear instead of the linear
+response: the cost of a step does not depend on it.
+
+``--event``: ``--events`` consecutive events (elastic load step, kick, minimisation with
+the whole-element fallback, i.e. two increments of the protocol) from one seed, once with
+``relaxation = dynamic`` and once with ``exact`` (both start from the same linear
+response, solved directly). Prints per relaxation the total and median time steps and
+the wall time per event, for all events and by size ``A`` (blocks whose Gauss point 0
+changed well, all interfaces), and last
+``steps_ratio=<dynamic/exact, all> small_steps_ratio=<dynamic/exact, A < 10>
+time_ratio=<dynamic / exact wall time>``.
+
+``--linear-response``: the direct solve of the linear response (factorisation included);
+last line ``linear_response_s=<value>``.
+
+Compilation is always excluded (a warm-up first; numba's cache makes later runs start fast).
 """
 
 import argparse
@@ -23,6 +36,9 @@ from stickslip.fem.parameters import FemParams
 from stickslip.fem.system import System
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.numba_options import njit, set_num_threads
+
+#: Events with fewer blocks yielding than this are "small" in the summary.
+SMALL = 10
 
 
 @njit
@@ -43,36 +59,10 @@ def _affine_response(system):
     system.restore(np.zeros(system.model.ndof), np.zeros(system.mesh.nlayer), 0.0, 0.0)
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--N", type=int, default=1458, help="blocks per interface")
-    parser.add_argument("--plates", type=int, default=2)
-    parser.add_argument("--threads", type=int, default=1)
-    parser.add_argument("--steps", type=int, default=2000, help="time steps to time")
-    parser.add_argument("--event", action="store_true", help="time one event (load, kick, minimisation)")
-    args = parser.parse_args(argv)
-    threads = set_num_threads(args.threads)
-    mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
+def _per_step(args, mesh, threads):
     system = System(FemParams(N=args.N, plates=args.plates, nchunk=200), mesh, threads=threads)
-    print(f"N={args.N} plates={args.plates} elements={mesh.nelem} dofs={system.model.ndof} threads={threads}")
-    start = time.perf_counter()
-    if args.event:
-        system.compute_linear_response()
-    else:  # timing steps needs no equilibrium: an affine shear is a valid loading direction, and cheap
-        _affine_response(system)
-    print(f"linear response: {time.perf_counter() - start:.1f} s (includes compilation)")
+    _affine_response(system)
     system.event_step(kick=False)
-    if args.event:
-        start = time.perf_counter()
-        system.event_step(kick=False)
-        system.event_step(kick=True)
-        t0 = system.state.t[0]
-        niter, _ = system.minimise(margin=5)
-        seconds = time.perf_counter() - start
-        nsteps = int(round((system.state.t[0] - t0) / system.model.dt))
-        print(f"event: steps={nsteps} seconds={seconds:.3f} niter={niter}")
-        print(f"time_per_step_us={seconds / nsteps * 1e6:.1f}")
-        return
     index = system.state.idx.copy()
     system.event_step(kick=True)
     _steps(system.model, system.state, system._fe, 10)  # warm up (compiles if not cached)
@@ -84,6 +74,94 @@ def main(argv=None):
     print(f"steps={args.steps} seconds={seconds:.3f} gauss_points_yielded={yielded} "
           f"ns_per_element_step={per_step * 1e3 / mesh.nelem:.1f}")
     print(f"time_per_step_us={per_step:.1f}")
+
+
+def _events(system, count):
+    """Run ``count`` events; returns arrays (steps, seconds, A) per event."""
+    steps, seconds, sizes = [], [], []
+    dt = system.model.dt
+    for _ in range(count):
+        system.event_step(kick=False)
+        before = system.state.idx[:, 0].copy()
+        t0 = system.state.t[0]
+        start = time.perf_counter()
+        converged, _ = system.kick(system.params.margin)
+        seconds.append(time.perf_counter() - start)
+        if not converged:
+            raise SystemExit("a block reached the end of its yield strains: use fewer --events or a larger --nchunk")
+        steps.append(int(round((system.state.t[0] - t0) / dt)))
+        sizes.append(int(np.count_nonzero(system.state.idx[:, 0] != before)))
+    return np.array(steps), np.array(seconds), np.array(sizes)
+
+
+def _summary(name, steps, seconds, sizes):
+    for label, keep in (("all", sizes >= 0), (f"A<{SMALL}", sizes < SMALL), (f"A>={SMALL}", sizes >= SMALL)):
+        if not keep.any():
+            print(f"{name:8s} {label:6s} events=0")
+            continue
+        print(f"{name:8s} {label:6s} events={keep.sum():4d} steps_total={steps[keep].sum():10d} "
+              f"steps_median={np.median(steps[keep]):9.0f} seconds_per_event={seconds[keep].mean():.4f}")
+
+
+def _event_mode(args, mesh, threads):
+    runs = {}
+    response = None
+    for relaxation in ("dynamic", "exact"):
+        params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, nchunk=args.nchunk, seed=args.seed,
+                           relaxation=relaxation)
+        system = System(params, mesh, threads=threads)
+        if response is None:
+            exact = System(params, mesh, threads=threads)
+            start = time.perf_counter()
+            exact.compute_linear_response()
+            print(f"linear response (direct solve, includes compilation): {time.perf_counter() - start:.2f} s")
+            response = (exact.delta_u, exact.delta_eps, exact.delta_target, exact.delta_lever)
+        system.set_linear_response(*response)
+        _ = system.equilibrium  # factorise outside the timing (once per run)
+        runs[relaxation] = _events(system, args.events)
+        _summary(relaxation, *runs[relaxation])
+    dyn, fast = runs["dynamic"], runs["exact"]
+    same = int(np.argmin(dyn[2] == fast[2])) if not np.array_equal(dyn[2], fast[2]) else args.events
+    print(f"event sizes A equal for the first {same} of {args.events} events")
+    small = fast[2] < SMALL
+    small_dyn = dyn[2] < SMALL
+    small_ratio = (dyn[0][small_dyn].mean() / fast[0][small].mean()) if small.any() and small_dyn.any() else np.nan
+    print(f"steps_ratio={dyn[0].sum() / fast[0].sum():.2f} small_steps_ratio={small_ratio:.2f} "
+          f"time_ratio={dyn[1].sum() / fast[1].sum():.2f}")
+
+
+def _linear_response_mode(args, mesh, threads):
+    warm = System(FemParams(N=9, plates=2, nchunk=200, relaxation="exact"), build_stack_mesh(MeshParams(N=9)))
+    warm.compute_linear_response()  # compiles the kernels if not cached
+    system = System(FemParams(N=args.N, plates=args.plates, nchunk=args.nchunk, relaxation="exact"), mesh,
+                    threads=threads)
+    start = time.perf_counter()
+    system.compute_linear_response()
+    print(f"linear_response_s={time.perf_counter() - start:.2f}")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--N", type=int, default=1458, help="blocks per interface")
+    parser.add_argument("--plates", type=int, default=2)
+    parser.add_argument("--threads", type=int, default=1)
+    parser.add_argument("--steps", type=int, default=2000, help="time steps to time (per-step mode)")
+    parser.add_argument("--event", action="store_true", help="consecutive events with both relaxations")
+    parser.add_argument("--events", type=int, default=100, help="number of events (--event)")
+    parser.add_argument("--k_drive", type=float, default=1e-3, help="drive stiffness per unit volume (--event)")
+    parser.add_argument("--seed", type=int, default=0, help="realisation (--event)")
+    parser.add_argument("--nchunk", type=int, default=1000, help="yield strains per block (--event)")
+    parser.add_argument("--linear-response", action="store_true", help="time the direct linear response")
+    args = parser.parse_args(argv)
+    threads = set_num_threads(args.threads)
+    mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
+    print(f"N={args.N} plates={args.plates} elements={mesh.nelem} dofs={2 * mesh.nnode} threads={threads}")
+    if args.event:
+        _event_mode(args, mesh, threads)
+    elif args.linear_response:
+        _linear_response_mode(args, mesh, threads)
+    else:
+        _per_step(args, mesh, threads)
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ from numba import prange
 from ..numba_options import njit
 from .materials import cusp_stress, equivalent_strain, well_index
 
-__all__ = ["compute_force", "interface_strain", "layer_ubar"]
+__all__ = ["compute_force", "compute_force_in_wells", "wells_hold", "interface_strain", "layer_ubar"]
 
 
 @njit
@@ -64,7 +64,7 @@ def _plates_rows(lo, hi, ptr, col, val, u, f):
 
 
 @njit
-def _interface_elements(lo, hi, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe):
+def _interface_elements(lo, hi, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe, update_wells):
     ue = np.empty(8)
     for e in range(lo, hi):
         for a in range(8):
@@ -76,8 +76,10 @@ def _interface_elements(lo, hi, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, 
             xx = eps[e, q, 0]
             yy = eps[e, q, 1]
             xy = eps[e, q, 2]
-            i = well_index(epsy[e], equivalent_strain(xx, yy, xy), idx[e, q])
-            idx[e, q] = i
+            i = idx[e, q]
+            if update_wells:
+                i = well_index(epsy[e], equivalent_strain(xx, yy, xy), i)
+                idx[e, q] = i
             eps_min = 0.5 * (epsy[e, i] + epsy[e, i + 1])
             sxx, syy, sxy = cusp_stress(xx, yy, xy, K, G, eps_min)
             sig[e, q, 0] = sxx
@@ -103,11 +105,12 @@ def _plates_rows_parallel(nblock, ptr, col, val, u, f):
 
 
 @njit(parallel=True)
-def _interface_elements_parallel(nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe):
+def _interface_elements_parallel(nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe,
+                                 update_wells):
     n = iface_dofs.shape[0]
     for b in prange(nblock):
         _interface_elements(b * n // nblock, (b + 1) * n // nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u,
-                            idx, eps, sig, fe)
+                            idx, eps, sig, fe, update_wells)
 
 
 @njit
@@ -142,6 +145,23 @@ def _drive(model, state):
 
 
 @njit
+def _force(model, state, fe, update_wells):
+    m = model
+    if m.nblock > 1:
+        _plates_rows_parallel(m.nblock, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+        _interface_elements_parallel(m.nblock, m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G, state.u,
+                                     state.idx, state.eps, state.sig, fe, update_wells)
+    else:
+        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+        _interface_elements(0, m.iface_dofs.shape[0], m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G,
+                            state.u, state.idx, state.eps, state.sig, fe, update_wells)
+    for e in range(model.iface_dofs.shape[0]):
+        for a in range(8):
+            state.f[model.iface_dofs[e, a]] += fe[e, a]
+    _drive(model, state)
+
+
+@njit
 def compute_force(model, state, fe):
     """Evaluate ``state.f`` (and interface strain, stress, well index, ubar, drive targets) from ``state.u``.
 
@@ -154,16 +174,30 @@ def compute_force(model, state, fe):
     fe : numpy.ndarray
         [ni, 8] work array.
     """
-    m = model
-    if m.nblock > 1:
-        _plates_rows_parallel(m.nblock, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
-        _interface_elements_parallel(m.nblock, m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G, state.u,
-                                     state.idx, state.eps, state.sig, fe)
-    else:
-        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
-        _interface_elements(0, m.iface_dofs.shape[0], m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G,
-                            state.u, state.idx, state.eps, state.sig, fe)
-    for e in range(model.iface_dofs.shape[0]):
-        for a in range(8):
-            state.f[model.iface_dofs[e, a]] += fe[e, a]
-    _drive(model, state)
+    _force(model, state, fe, True)
+
+
+@njit
+def compute_force_in_wells(model, state, fe):
+    """As :func:`compute_force`, but every Gauss point keeps its well ``state.idx`` whatever its strain.
+
+    Within fixed wells the force is the gradient of the energy of the current wells'
+    parabolas (:mod:`.equilibrium`); ``state.idx`` is read, not written.
+    """
+    _force(model, state, fe, False)
+
+
+@njit
+def wells_hold(model, state):
+    """True if every interface Gauss point's strain ``state.eps`` lies in its well ``state.idx``.
+
+    Uses :func:`.materials.well_index` on the stored strain, i.e. exactly the test that
+    :func:`compute_force` would apply to the same displacement.
+    """
+    for e in range(state.idx.shape[0]):
+        for q in range(4):
+            i = state.idx[e, q]
+            x = equivalent_strain(state.eps[e, q, 0], state.eps[e, q, 1], state.eps[e, q, 2])
+            if well_index(model.epsy[e], x, i) != i:
+                return False
+    return True

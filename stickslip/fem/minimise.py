@@ -18,9 +18,15 @@ import numpy as np
 from ..numba_options import njit
 from .dynamics import residual, time_step
 
-__all__ = ["minimise", "within_margin", "MAX_ITER_REACHED"]
+__all__ = ["minimise", "within_margin", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED"]
 
-#: Return value of :func:`minimise` when ``max_iter`` steps did not converge.
+#: Status of :func:`minimise`: the residual criterion was met (state quenched).
+CONVERGED = 1
+#: Status of :func:`minimise`: a Gauss point came within ``margin`` wells of the end of its sequence.
+MARGIN = 0
+#: Status of :func:`minimise`: ``quiet`` consecutive steps without any well change (not quenched).
+QUIET = 2
+#: Status of :func:`minimise`: ``max_iter`` steps did not converge.
 MAX_ITER_REACHED = -1
 
 
@@ -45,7 +51,7 @@ def _grow(events, n):
 
 
 @njit
-def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record):
+def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record, quiet=0):
     """Minimise by time stepping (see module doc).
 
     Parameters
@@ -65,11 +71,18 @@ def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record):
         Stop when an index comes within this many wells of the end (0: never).
     record : bool
         Record block failures (Gauss point 0).
+    quiet : int, optional
+        If > 0, also stop (returning ``QUIET``, without quench) once ``quiet``
+        consecutive steps changed no well index of any Gauss point; the caller may then
+        solve for the equilibrium within the current wells (:mod:`.equilibrium`) and
+        call again to continue. 0: never (the paper's protocol).
 
     Returns
     -------
+    status : int
+        ``CONVERGED`` (quenched), ``MARGIN``, ``QUIET`` or ``MAX_ITER_REACHED``.
     niter : int
-        Steps made if converged; 0 if stopped by the margin; ``MAX_ITER_REACHED`` otherwise.
+        Steps made by this call.
     events : numpy.ndarray
         float64 [nevent, 3]: (interface element, time, direction) (empty unless ``record``).
     """
@@ -77,6 +90,8 @@ def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record):
     tol2 = tol * tol
     ni = state.idx.shape[0]
     previous = state.idx[:, 0].copy()
+    wells = state.idx.copy() if quiet > 0 else np.empty((0, 4), dtype=np.int64)
+    unchanged = 0
     events = np.empty((16 if record else 0, 3))
     nevent = 0
     for iiter in range(1, max_iter + 1):
@@ -107,7 +122,16 @@ def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record):
         if (below and descending) or below2:
             state.v[:] = 0.0
             state.a[:] = 0.0
-            return iiter, events[:nevent]
+            return CONVERGED, iiter, events[:nevent]
         if margin > 0 and not within_margin(model, state.idx, margin):
-            return 0, events[:nevent]
-    return MAX_ITER_REACHED, events[:nevent]
+            return MARGIN, iiter, events[:nevent]
+        if quiet > 0:
+            unchanged += 1
+            for e in range(ni):
+                for q in range(4):
+                    if state.idx[e, q] != wells[e, q]:
+                        wells[e, q] = state.idx[e, q]
+                        unchanged = 0
+            if unchanged >= quiet:
+                return QUIET, iiter, events[:nevent]
+    return MAX_ITER_REACHED, max_iter, events[:nevent]

@@ -9,10 +9,14 @@ import dataclasses
 
 from ..params import ParameterError, param
 
-__all__ = ["FemParams", "DRIVES"]
+__all__ = ["FemParams", "DRIVES", "RELAXATIONS"]
 
 #: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
 DRIVES = ("fixed-lever", "free-lever")
+
+#: How a minimisation ends: by damped dynamics only (the paper's protocol), or by an exact solve
+#: within the current wells once no well has changed for ``quiet_steps`` (docs/fem.md).
+RELAXATIONS = ("dynamic", "exact")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -40,6 +44,13 @@ class FemParams:
     tol: float = param(1e-5, "minimisation: relative residual tolerance", exclusive_minimum=0.0, maximum=0.5)
     niter_tol: int = param(20, "minimisation: consecutive steps below tol (and non-increasing)", minimum=1)
     max_iter: int = param(10_000_000, "minimisation: maximum time steps (then the run fails)", minimum=1)
+    relaxation: str = param("dynamic", "how minimisations end: 'dynamic' (damped dynamics until the residual "
+                                       "criterion, the paper's protocol) or 'exact' (equilibrium of the current wells "
+                                       "solved directly once no well changed for quiet_steps, accepted only if every "
+                                       "Gauss point stays in its well; linear response by a direct solve)",
+                            choices=RELAXATIONS)
+    quiet_steps: int = param(200, "relaxation 'exact': time steps without any well change before an equilibrium "
+                                  "solve is tried (and between tries)", minimum=1)
     margin: int = param(5, "stop when a block comes within this many wells of the end of its sequence",
                         minimum=1)
     lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",

@@ -15,8 +15,6 @@ Reference: shared/reference-model.md, section 8c.
 
 from pathlib import Path
 
-import numpy as np
-
 from ..h5io import FileFormatError, atomic_output, open_file
 from ..params import params_to_dict
 from .minimise import within_margin
@@ -41,22 +39,6 @@ def _create(path, params, mesh, threads):
         with open_file(tmp, "w") as file:
             create_file(file, system, observer)
             append_increment(file, system, _row(observer, 0, True, False, observer.well_index()))
-
-
-def _kick(system, margin):
-    """Kick and minimise, with the whole-element fallback; returns (converged, yield_element)."""
-    before = system.snapshot()
-    index = system.state.idx.copy()
-    system.event_step(True)
-    niter, _ = system.minimise(margin=margin)
-    if niter == 0:
-        return False, False
-    if np.array_equal(system.state.idx, index):
-        system.restore(*before)
-        system.event_step(True, yield_element=True)
-        niter, _ = system.minimise(margin=margin)
-        return niter != 0, True
-    return True, False
 
 
 def run_simulation(params, output, mesh, threads=1):
@@ -110,7 +92,7 @@ def run_simulation(params, output, mesh, threads=1):
             kick = not kick
             yield_element = False
             if kick:
-                converged, yield_element = _kick(system, params.margin)
+                converged, yield_element = system.kick(params.margin)
                 if not converged:
                     reason = "margin"
                     break

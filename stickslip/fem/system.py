@@ -10,9 +10,10 @@ import math
 
 import numpy as np
 
+from .equilibrium import WellEquilibrium
 from .event_driven import autoscale, step_size
 from .forces import compute_force
-from .minimise import MAX_ITER_REACHED, minimise
+from .minimise import CONVERGED, MARGIN, MAX_ITER_REACHED, QUIET, minimise
 from .model import build_model, new_state
 from .yield_strains import interface_initstate, yield_strains
 
@@ -94,6 +95,7 @@ class System:
         self._fe = np.zeros((self.model.iface_dofs.shape[0], 8))
         self.delta_u = self.delta_eps = self.delta_target = None
         self.delta_lever = 0.0
+        self._equilibrium = None
         self.refresh()
 
     # --- state -----------------------------------------------------------------------------
@@ -132,13 +134,51 @@ class System:
 
     # --- protocol --------------------------------------------------------------------------
 
+    @property
+    def equilibrium(self):
+        """The factorised constant stiffness (:class:`.equilibrium.WellEquilibrium`), built on first use."""
+        if self._equilibrium is None:
+            self._equilibrium = WellEquilibrium(self.model)
+        return self._equilibrium
+
+    def relax_in_wells(self):
+        """Replace the state by the equilibrium of its current wells if every Gauss point stays in its well.
+
+        Returns
+        -------
+        bool
+            True if the state (now at rest) was replaced.
+        """
+        found = self.equilibrium.relax(self.model, self.state, self._fe, self.params.tol)
+        if found is None:
+            return False
+        for name, value in zip(found._fields, found):
+            getattr(self.state, name)[...] = value
+        return True
+
     def minimise(self, margin=0, record=False):
-        """Minimise by damped dynamics (:func:`.minimise.minimise`).
+        """Minimise: the kick's relaxation (:func:`.minimise.minimise`, then with ``relaxation = exact`` solves).
+
+        ``relaxation = dynamic``: damped dynamics until the residual criterion (the
+        paper's protocol). ``relaxation = exact``: the same dynamics, interrupted once
+        ``quiet_steps`` steps changed no well index; then the equilibrium of the current
+        wells is solved (:meth:`relax_in_wells`) and accepted if every Gauss point of it
+        lies in its current well, otherwise the dynamics continue (and a solve is tried
+        again after the next ``quiet_steps`` steps without a change). When the residual
+        criterion is met first, the solve is tried too (its result, if accepted, replaces
+        the quenched state). The state's time ``t`` counts the time steps made.
+
+        Parameters
+        ----------
+        margin : int, optional
+            Stop when a Gauss point comes within this many wells of the end of its sequence.
+        record : bool, optional
+            Record the well changes of Gauss point 0 (see :func:`.minimise.minimise`).
 
         Returns
         -------
         niter : int
-            Steps if converged, 0 if stopped by the margin.
+            Time steps made if converged, 0 if stopped by the margin.
         events : numpy.ndarray
             [nevent, 3] (element, time, direction) when ``record``.
 
@@ -148,18 +188,34 @@ class System:
             If ``max_iter`` steps do not converge.
         """
         p = self.params
-        niter, events = minimise(self.model, self.state, self._fe, p.tol, p.niter_tol, p.max_iter, margin, record)
-        if niter == MAX_ITER_REACHED:
-            raise SolverError(f"minimisation did not converge in max_iter = {p.max_iter} steps")
-        return niter, events
+        quiet = p.quiet_steps if p.relaxation == "exact" else 0
+        total = 0
+        found = []
+        while True:
+            status, niter, events = minimise(self.model, self.state, self._fe, p.tol, p.niter_tol,
+                                             p.max_iter - total, margin, record, quiet)
+            total += niter
+            found.append(events)
+            events = np.concatenate(found) if len(found) > 1 else events
+            if status == MAX_ITER_REACHED:
+                raise SolverError(f"minimisation did not converge in max_iter = {p.max_iter} steps")
+            if status == MARGIN:
+                return 0, events
+            if quiet and self.relax_in_wells():
+                return total, events
+            if status == CONVERGED:
+                return total, events
+            assert status == QUIET
 
     def compute_linear_response(self):
         """Compute the scaled elastic response to a unit drive (all interfaces elastic).
 
         Fixed lever: targets ``2 eps0 H_l`` (affine simple shear ``gamma = eps0``);
-        free lever: lever drive target ``eps0``. Minimised from rest, then scaled so that
-        the largest interface equivalent strain is 0.1 of the narrowest well.
-        The current state is not changed.
+        free lever: lever drive target ``eps0``. ``relaxation = dynamic``: minimised from
+        rest by damped dynamics (the paper's protocol); ``exact``: one direct solve with
+        the run's factorisation (the model is linear). Then scaled so that the largest
+        interface equivalent strain is 0.1 of the narrowest well. The current state is
+        not changed.
         """
         huge = np.finfo(np.float64).max
         elastic = self.model._replace(epsy=np.tile(np.array([[-huge, huge]]), (self.model.epsy.shape[0], 1)))
@@ -172,7 +228,11 @@ class System:
         self.model = elastic
         try:
             self.refresh()
-            self.minimise()
+            if self.params.relaxation == "exact":
+                if not self.relax_in_wells():
+                    raise SolverError("the direct solve of the linear response did not converge")
+            else:
+                self.minimise()
             u, eps = self.state.u.copy(), self.state.eps.copy()
         finally:
             self.model = model
@@ -224,3 +284,36 @@ class System:
             raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
                               f"{'did not change' if kick else 'changed'}")
         return step
+
+    def kick(self, margin):
+        """Kick and minimise (an even increment of the protocol), with the whole-element fallback.
+
+        :meth:`event_step` (kick) then :meth:`minimise`; if the minimisation ends with no
+        well index changed (the kicked point fell back), the state before the kick is
+        restored and the kick redone so that all Gauss points of one element yield
+        (``yield_element``).
+
+        Parameters
+        ----------
+        margin : int
+            Stop when a Gauss point comes within this many wells of the end of its sequence.
+
+        Returns
+        -------
+        converged : bool
+            False if stopped by the margin.
+        yield_element : bool
+            Whether the whole-element kick was needed.
+        """
+        before = self.snapshot()
+        index = self.state.idx.copy()
+        self.event_step(True)
+        niter, _ = self.minimise(margin=margin)
+        if niter == 0:
+            return False, False
+        if np.array_equal(self.state.idx, index):
+            self.restore(*before)
+            self.event_step(True, yield_element=True)
+            niter, _ = self.minimise(margin=margin)
+            return niter != 0, True
+        return True, False
