@@ -3,9 +3,13 @@
 Time steps are made until the relative residual (:func:`.dynamics.residual`) of
 the last ``niter_tol`` steps are all below ``tol`` and non-increasing, or all
 below ``tol^2``; then velocity and acceleration are set to zero (quench).
-With a margin, the minimisation also stops (returning 0) as soon as a Gauss point
+With a margin, the minimisation also stops (status ``MARGIN``) as soon as a Gauss point
 of an interface comes within ``margin`` wells of the end of its yield-strain
 sequence (the reference's ``minimise_boundcheck``: index ``>= ny - margin``).
+
+With ``quiet > 0`` it also stops (status ``QUIET``, not quenched) once ``quiet``
+consecutive steps changed no well index, so that the caller can try the equilibrium
+solve of ``relaxation = exact`` (:meth:`.system.System.minimise`) and call again.
 
 Recording (for the event maps): every change of the well index of Gauss point
 0 of an interface element is stored as one row per hop
