@@ -1,7 +1,5 @@
 """The exact relaxation (``relaxation = exact``): equilibrium within fixed wells, direct linear response, runs."""
 
-import shutil
-
 import h5py
 import numpy as np
 import pandas as pd
@@ -96,23 +94,29 @@ def _run(output, **values):
     plugin.run(params, output, threads=1, inputs={})
 
 
-def test_exact_runs_are_reproducible_resume_identically_and_record_the_relaxation(tmp_path):
+def test_exact_runs_are_reproducible_resume_identically_and_record_the_relaxation(tmp_path, monkeypatch):
     first, second = tmp_path / "a.h5", tmp_path / "b.h5"
     _run(first)
     _run(second)
     assert first.read_bytes() == second.read_bytes()
     attrs = read_run_attrs(first)
     assert attrs["params"]["relaxation"] == "exact" and attrs["params"]["quiet_steps"] == 200
+    # interrupted in the middle of the 31st kick (as by Ctrl-C), then resumed
     partial = tmp_path / "partial.h5"
-    shutil.copy(first, partial)
-    with h5py.File(partial, "r+") as file:  # as if killed while writing increment 61
-        keep = 60
-        for group in ("state", "increments"):
-            for name in file[group]:
-                file[group][name].resize(keep, axis=0)
-        file.attrs["nstored"] = keep
-        file.attrs["completed"] = False
-        file.attrs["stop_reason"] = ""
+    kick = System.kick
+    calls = []
+
+    def interrupted(self, margin):
+        calls.append(1)
+        if len(calls) == 31:
+            raise KeyboardInterrupt
+        return kick(self, margin)
+
+    monkeypatch.setattr(System, "kick", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        _run(partial)
+    monkeypatch.setattr(System, "kick", kick)
+    assert len(read_increments(partial)) == 62  # increment 0, 30 load steps and kicks, the 31st load step
     _run(partial)
     pd.testing.assert_frame_equal(read_increments(partial), read_increments(first))
     with h5py.File(partial) as a, h5py.File(first) as b:
