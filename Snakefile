@@ -1,6 +1,7 @@
 # stickslip: the whole study, from the config to the figures and the results database.
 # `snakemake --cores 2` runs workflow/config/default.yaml; `--configfile FILE` runs another study
-# (it replaces the default config, it is not merged with it). See docs/workflow.md.
+# (it replaces the default config, it is not merged with it). Each study writes under results/{study}/
+# (the config's `study` key, default: the config file's stem). See docs/workflow.md.
 
 from snakemake.utils import min_version, validate
 
@@ -30,4 +31,4 @@ rule all:
     default_target: True
     input:
         STUDY.outputs(),
-        PATHS["database"],
+        STUDY.path("database"),

@@ -2,6 +2,7 @@
 
 Config layout (``workflow/config/*.yaml``, schema ``workflow/schemas/config.schema.yaml``)::
 
+    study: default                  # results tree results/{study}/ (default: the config file's stem)
     threads: 1                      # numba threads of each simulation job
     solvers:                        # solver name -> list of sweeps
       lever:
@@ -16,28 +17,69 @@ A run's parameters are its sweep's ``params`` overridden by one combination of
 its ``grid``; its id is :func:`stickslip.registry.run_id` of those parameters.
 An analysis runs on every simulation of the solvers it accepts; a figure reads
 every output of each input category it declares (``solver:<name>``,
-``analysis:<name>``, ``mesh``). Paths follow :data:`PATHS`.
+``analysis:<name>``, ``mesh``).
+
+Each study writes under its own results tree, ``results/{study}/``: outputs
+(:data:`PATHS`), logs and the database, so studies run in one clone never
+overwrite each other.
 """
 
 import dataclasses
 import itertools
 import json
+import re
+from pathlib import Path
 
 from . import registry
 from .params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import record_path
 
-__all__ = ["PATHS", "Simulation", "AnalysisJob", "FigureJob", "Study", "plugin_sections", "normalise"]
+__all__ = ["RESULTS", "PATHS", "study_name", "Simulation", "AnalysisJob", "FigureJob", "Study", "plugin_sections",
+           "normalise"]
 
-#: Output path patterns (relative to the workflow's working directory).
+#: Directory of the studies' results trees (relative to the workflow's working directory).
+RESULTS = "results"
+
+#: Path patterns inside a study's results tree ``results/{study}/``.
 PATHS = {
-    "mesh": "results/mesh/{mesh_id}.h5",
-    "simulation": "results/sim/{solver}/{run_id}.h5",
-    "events": "results/events/{analysis}/{solver}/{run_id}.h5",
-    "figure": "results/figures/{figure}.pdf",
-    "database": "results/stickslip.sqlite",
+    "mesh": "mesh/{mesh_id}.h5",
+    "simulation": "sim/{solver}/{run_id}.h5",
+    "events": "events/{analysis}/{solver}/{run_id}.h5",
+    "figure": "figures/{figure}.pdf",
+    "database": "stickslip.sqlite",
+    "logs": "logs",
+    "benchmark": "logs/benchmarks/sim/{solver}/{run_id}.tsv",
 }
+
+_STUDY_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+
+def study_name(config, configfiles=()):
+    """Return the name of a study: the config's ``study`` key, else the stem of its config file.
+
+    Parameters
+    ----------
+    config : dict
+        The workflow config.
+    configfiles : Sequence[str or pathlib.Path]
+        The config files it was read from (the last one names the study); none: ``"default"``.
+
+    Returns
+    -------
+    str
+        A path component: a letter or digit, then letters, digits, ``_``, ``.``, ``-``.
+
+    Raises
+    ------
+    ParameterError
+        If the name is not a valid path component.
+    """
+    name = config.get("study") or (Path(configfiles[-1]).stem if configfiles else "default")
+    if not _STUDY_NAME.match(str(name)):
+        raise ParameterError(f"config key study: expected a name matching {_STUDY_NAME.pattern} "
+                             f"(it is a directory under {RESULTS}/), got {name!r}")
+    return str(name)
 
 SECTIONS = {"solvers": "solver", "analyses": "analysis", "figures": "figure"}
 
@@ -52,6 +94,8 @@ class Simulation:
     run_id : str
     params : dict
         Defaults-filled, JSON-safe parameters.
+    path : str
+        Output file.
     mesh_id : str or None
         Id of the mesh file it reads (solvers that declare the ``"mesh"`` input).
     """
@@ -59,26 +103,17 @@ class Simulation:
     solver: str
     run_id: str
     params: dict
+    path: str
     mesh_id: str | None = None
-
-    @property
-    def path(self):
-        """Output file."""
-        return PATHS["simulation"].format(solver=self.solver, run_id=self.run_id)
 
 
 @dataclasses.dataclass(frozen=True)
 class AnalysisJob:
-    """One analysis of one simulation output."""
+    """One analysis of one simulation output (``path``: the output file)."""
 
     analysis: str
     simulation: Simulation
-
-    @property
-    def path(self):
-        """Output file."""
-        return PATHS["events"].format(analysis=self.analysis, solver=self.simulation.solver,
-                                      run_id=self.simulation.run_id)
+    path: str
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,16 +126,14 @@ class FigureJob:
     params : dict
     inputs : dict[str, list[str]]
         Input category -> sorted paths.
+    path : str
+        Output PDF (the PNG is beside it).
     """
 
     figure: str
     params: dict
     inputs: dict
-
-    @property
-    def path(self):
-        """Output PDF (the PNG is beside it)."""
-        return PATHS["figure"].format(figure=self.figure)
+    path: str
 
 
 def _where(section, name, *rest):
@@ -196,6 +229,9 @@ class Study:
     ----------
     config : dict
         The workflow config, checked against the schema (see :func:`plugin_sections`).
+    configfiles : Sequence[str or pathlib.Path], optional
+        The config files read; the last one's stem names the study when the config
+        has no ``study`` key (see :func:`study_name`).
 
     Raises
     ------
@@ -206,6 +242,9 @@ class Study:
 
     Attributes
     ----------
+    name : str
+    root : str
+        Its results tree, ``results/{name}``: every output, log and the database.
     threads : int
     simulations : list[Simulation]
         Sorted by solver, then run id; no duplicates.
@@ -217,8 +256,10 @@ class Study:
     figures : dict[str, FigureJob]
     """
 
-    def __init__(self, config):
+    def __init__(self, config, configfiles=()):
         normalise(config)
+        self.name = study_name(config, configfiles)
+        self.root = f"{RESULTS}/{self.name}"
         self.threads = int(config.get("threads", 1))
         self.meshes = {}
         self.simulations = self._simulations(config.get("solvers") or {})
@@ -245,7 +286,8 @@ class Study:
                     if "mesh" in plugin.inputs:
                         mesh_id, mesh_params = _mesh_for(as_dict)
                         self.meshes[mesh_id] = mesh_params
-                    runs[(name, run)] = Simulation(name, run, as_dict, mesh_id)
+                    runs[(name, run)] = Simulation(name, run, as_dict,
+                                                   self.path("simulation", solver=name, run_id=run), mesh_id)
         return [runs[key] for key in sorted(runs)]
 
     def _analyses(self, analyses):
@@ -253,7 +295,8 @@ class Study:
         for name, values in analyses.items():
             plugin = _plugin("analysis", name, _where("analyses", name))
             chosen[name] = params_to_dict(_parse(plugin, values, _where("analyses", name)))
-            mine = [AnalysisJob(name, sim) for sim in self.simulations if sim.solver in plugin.inputs]
+            mine = [AnalysisJob(name, sim, self.path("events", analysis=name, solver=sim.solver, run_id=sim.run_id))
+                    for sim in self.simulations if sim.solver in plugin.inputs]
             if not mine:
                 raise ParameterError(f"config analyses.{name}: it reads outputs of the solver(s) "
                                      f"{', '.join(plugin.inputs) or '(none)'}, which the study does not run")
@@ -263,7 +306,7 @@ class Study:
     def _category_paths(self, category):
         kind, _, name = category.partition(":")
         if category == "mesh":
-            return [PATHS["mesh"].format(mesh_id=m) for m in sorted(self.meshes)]
+            return [self.path("mesh", mesh_id=m) for m in sorted(self.meshes)]
         if kind == "solver":
             return [sim.path for sim in self.simulations if sim.solver == name]
         if kind == "analysis":
@@ -285,10 +328,35 @@ class Study:
                     raise ParameterError(f"config figures.{name}: it reads {category} outputs, which the "
                                          "study does not produce (add the solver or analysis to the config)")
                 inputs[category] = sorted(paths)
-            jobs[name] = FigureJob(name, params, inputs)
+            jobs[name] = FigureJob(name, params, inputs, self.path("figure", figure=name))
         return jobs
 
     # Look-ups used by the rules ------------------------------------------------------------
+
+    def path(self, kind, **fields):
+        """Return a path in the study's results tree.
+
+        Parameters
+        ----------
+        kind : str
+            A key of :data:`PATHS`.
+        **fields
+            Values of the pattern's fields; those left out stay as ``{field}``
+            (a Snakemake wildcard).
+
+        Returns
+        -------
+        str
+            ``results/{study}/`` + the pattern.
+        """
+        pattern = PATHS[kind]
+        for key, value in fields.items():
+            pattern = pattern.replace("{" + key + "}", str(value))
+        return f"{self.root}/{pattern}"
+
+    def log(self, name):
+        """Return the log file ``results/{study}/logs/{name}.log`` (``name`` may hold wildcards)."""
+        return f"{self.root}/{PATHS['logs']}/{name}.log"
 
     def simulation(self, solver, run_id):
         """Return the :class:`Simulation` with this solver and run id (KeyError if none)."""
@@ -300,11 +368,11 @@ class Study:
     def solver_inputs(self, solver, run_id):
         """Return the upstream files of one simulation, by category (``{"mesh": path}`` or ``{}``)."""
         sim = self.simulation(solver, run_id)
-        return {} if sim.mesh_id is None else {"mesh": PATHS["mesh"].format(mesh_id=sim.mesh_id)}
+        return {} if sim.mesh_id is None else {"mesh": self.path("mesh", mesh_id=sim.mesh_id)}
 
     def outputs(self):
         """Return every output file of the study except the database (sorted)."""
-        paths = [PATHS["mesh"].format(mesh_id=m) for m in self.meshes]
+        paths = [self.path("mesh", mesh_id=m) for m in self.meshes]
         paths += [sim.path for sim in self.simulations]
         paths += [job.path for job in self.analysis_jobs]
         for job in self.figures.values():
@@ -313,7 +381,7 @@ class Study:
 
     def records(self):
         """Return the provenance record of every job (sorted): the database rule's input."""
-        paths = [PATHS["mesh"].format(mesh_id=m) for m in self.meshes]
+        paths = [self.path("mesh", mesh_id=m) for m in self.meshes]
         paths += [sim.path for sim in self.simulations]
         paths += [job.path for job in self.analysis_jobs]
         paths += [job.path for job in self.figures.values()]

@@ -185,12 +185,12 @@ def partial_path(output):
     Parameters
     ----------
     output : str or pathlib.Path
-        The simulation file of the rule, ``results/sim/{solver}/{run_id}.h5``.
+        The simulation file of the rule, ``results/{study}/sim/{solver}/{run_id}.h5``.
 
     Returns
     -------
     pathlib.Path
-        ``results/sim/{solver}/partial/{run_id}.h5``.
+        ``results/{study}/sim/{solver}/partial/{run_id}.h5``.
     """
     output = Path(output)
     return output.parent / "partial" / output.name

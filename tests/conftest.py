@@ -81,16 +81,17 @@ def toy_results(tmp_path, toy_plugins, monkeypatch):
     for seed in (1, 2):
         values = {"seed": seed, "slips": 4}
         run = registry.run_id(solver, parse_params(solver.params, values))
-        sim = f"results/sim/toy-spring-block/{run}.h5"
-        run_simulation("toy-spring-block", json.dumps(values), sim,
-                       sim.replace(".h5", ".provenance.json"), f"logs/{run}.log", inputs={}, threads=1)
-        event = f"results/events/toy-slips/toy-spring-block/{run}.h5"
-        run_analysis("toy-slips", "{}", sim, event, event.replace(".h5", ".provenance.json"), f"logs/e{run}.log")
+        sim = f"results/default/sim/toy-spring-block/{run}.h5"
+        run_simulation("toy-spring-block", json.dumps(values), sim, sim.replace(".h5", ".provenance.json"),
+                       f"results/default/logs/{run}.log", inputs={}, threads=1)
+        event = f"results/default/events/toy-slips/toy-spring-block/{run}.h5"
+        run_analysis("toy-slips", "{}", sim, event, event.replace(".h5", ".provenance.json"),
+                     f"results/default/logs/e{run}.log")
         sims.append(sim)
         events.append(event)
         records += [Path(sim.replace(".h5", ".provenance.json")), Path(event.replace(".h5", ".provenance.json"))]
     inputs = {"solver:toy-spring-block": sims, "analysis:toy-slips": events}
-    run_figure("toy-force", "{}", json.dumps(inputs), "results/figures/toy-force.pdf",
-               "results/figures/toy-force.provenance.json", "logs/figure.log")
-    records.append(Path("results/figures/toy-force.provenance.json"))
+    run_figure("toy-force", "{}", json.dumps(inputs), "results/default/figures/toy-force.pdf",
+               "results/default/figures/toy-force.provenance.json", "results/default/logs/figure.log")
+    records.append(Path("results/default/figures/toy-force.provenance.json"))
     return records

@@ -23,7 +23,7 @@ def _counts(database):
 
 
 def test_ingest_fills_every_table_from_records(toy_results):
-    database = "results/stickslip.sqlite"
+    database = "results/default/stickslip.sqlite"
     counts = ingest(database, toy_results)
     assert counts["records"] == 5
     table = _counts(database)
@@ -36,7 +36,7 @@ def test_ingest_fills_every_table_from_records(toy_results):
     # events: the slips of the table, one per slip, each equal to the file's values
     run = query.runs(database, kind="solver", seed=1)["run_id"].iloc[0]
     events = query.events(database, run_id=run)
-    with open_file(f"results/events/toy-slips/toy-spring-block/{run}.h5") as handle:
+    with open_file(f"results/default/events/toy-slips/toy-spring-block/{run}.h5") as handle:
         slips = read_table(handle, "slips")
     np.testing.assert_array_equal(events["slip"].to_numpy(), slips["dR"].to_numpy())
     np.testing.assert_array_equal(events["time"].to_numpy(), slips["t"].to_numpy())
@@ -48,20 +48,20 @@ def test_ingest_fills_every_table_from_records(toy_results):
 
 
 def test_ingest_is_idempotent_and_rebuild_matches(toy_results):
-    database = "results/stickslip.sqlite"
+    database = "results/default/stickslip.sqlite"
     ingest(database, toy_results)
     first = _counts(database)
     ingest(database, toy_results)
     ingest(database, toy_results[:2])
     assert _counts(database) == first
-    ingest(database, find_records("results"), rebuild=True)
+    ingest(database, find_records("results/default"), rebuild=True)
     assert _counts(database) == first
     ingest(database, toy_results[:1], rebuild=True)  # a rebuild holds exactly its records
     assert _counts(database)["runs"] == 1
 
 
 def test_an_interrupted_ingest_leaves_the_previous_database(toy_results, monkeypatch):
-    database = "results/stickslip.sqlite"
+    database = "results/default/stickslip.sqlite"
     ingest(database, toy_results[:2])
     before = _counts(database)
 
@@ -93,7 +93,7 @@ def _ingest_one(args):
 
 
 def test_concurrent_ingests_lose_no_record(toy_results):
-    database = "results/stickslip.sqlite"
+    database = "results/default/stickslip.sqlite"
     with multiprocessing.get_context("spawn").Pool(2) as pool:
         pool.map(_ingest_one, [(database, str(r)) for r in toy_results * 2])
     assert _counts(database)["runs"] == len(toy_results)
@@ -101,7 +101,7 @@ def test_concurrent_ingests_lose_no_record(toy_results):
 
 
 def test_queries_are_read_only_and_filter(toy_results):
-    database = "results/stickslip.sqlite"
+    database = "results/default/stickslip.sqlite"
     ingest(database, toy_results)
     with pytest.raises(query.QueryError, match="attempt to write a readonly database"):
         query.sql("DELETE FROM runs", database)
@@ -121,9 +121,9 @@ def test_simulation_columns_fall_back_to_file_attributes(tmp_path):
         handle.attrs.update({"n_interfaces": 3, "regime": "compliant", "k_drive": 1e-6})
     record = {"run_id": "0123456789abcdef", "plugin": "fem", "params": {"plates": 4, "N": 9, "seed": 2,
                                                                         "k_drive": 1e-6},
-              "outputs": [{"path": "results/sim/fem/0123456789abcdef.h5"}]}
+              "outputs": [{"path": "results/default/sim/fem/0123456789abcdef.h5"}]}
     row = ingest_module._simulation_row(record, tmp_path / "0123456789abcdef.provenance.json")
-    assert row == {"run_id": "0123456789abcdef", "solver": "fem", "path": "results/sim/fem/0123456789abcdef.h5",
+    assert row == {"run_id": "0123456789abcdef", "solver": "fem", "path": "results/default/sim/fem/0123456789abcdef.h5",
                    "source": "numerical", "protocol": None, "n": 3, "a": None, "plates": 4, "blocks": 9,
                    "k_drive": 1e-6, "regime": "compliant", "seed": 2}
 
@@ -132,8 +132,8 @@ def test_regime_stated_by_an_analysis_fills_its_simulation(toy_results):
     record = read_record(toy_results[1])  # the analysis of the seed-1 run
     with open_file(record["outputs"][0]["path"], "r+") as handle:
         handle.attrs["regime"] = "compliant"
-    ingest("results/stickslip.sqlite", toy_results)
-    runs = query.runs("results/stickslip.sqlite", kind="solver")
+    ingest("results/default/stickslip.sqlite", toy_results)
+    runs = query.runs("results/default/stickslip.sqlite", kind="solver")
     regimes = dict(zip(runs["seed"], runs["regime"]))
     assert regimes[1] == "compliant" and pd.isna(regimes[2])
-    assert len(query.events("results/stickslip.sqlite", regime="compliant")) == 4
+    assert len(query.events("results/default/stickslip.sqlite", regime="compliant")) == 4

@@ -64,7 +64,7 @@ def test_study_expands_grids_and_resolves_inputs(toy_plugins):
     assert len(figure.inputs["analysis:toy-slips"]) == 3
     assert len(study.records()) == 3 + 3 + 1
     sim = study.simulations[0]
-    assert sim.path == f"results/sim/toy-spring-block/{sim.run_id}.h5"
+    assert study.name == "default" and sim.path == f"results/default/sim/toy-spring-block/{sim.run_id}.h5"
 
 
 @pytest.mark.parametrize("change, message", [
@@ -123,7 +123,7 @@ def test_bad_config_value_stops_before_any_job(tmp_path, toy_distribution):
     result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
     assert result.returncode != 0
     assert "Additional properties are not allowed ('thread' was unexpected)" in result.stdout + result.stderr
-    assert not (tmp_path / "results").exists() and not (tmp_path / "logs").exists()
+    assert not (tmp_path / "results").exists()
 
 
 @pytest.fixture(scope="module")
@@ -138,7 +138,7 @@ def toy_workflow(tmp_path_factory, toy_distribution):
 @pytest.mark.slow
 def test_toy_workflow_outputs_records_and_database(toy_workflow):
     directory, _ = toy_workflow
-    results = directory / "results"
+    results = directory / "results" / "toy"  # the study is named after its config file
     sims = sorted((results / "sim" / "toy-spring-block").glob("*.h5"))
     events = sorted((results / "events" / "toy-slips" / "toy-spring-block").glob("*.h5"))
     assert len(sims) == 3 and len(events) == 3
@@ -162,8 +162,9 @@ def test_toy_workflow_outputs_records_and_database(toy_workflow):
         n_events = connection.execute("SELECT COUNT(*) FROM slip_events").fetchone()[0]
     assert run_ids == {read_record(path)["run_id"] for path in records}
     assert n_events == 3 * 4
-    assert (directory / "logs" / "benchmarks" / "sim" / "toy-spring-block" / f"{sims[0].stem}.tsv").is_file()
-    assert (directory / "logs" / "figures" / "toy-force.log").is_file()
+    assert (results / "logs" / "benchmarks" / "sim" / "toy-spring-block" / f"{sims[0].stem}.tsv").is_file()
+    assert (results / "logs" / "figures" / "toy-force.log").is_file()
+    assert sorted(p.name for p in (directory / "results").iterdir()) == ["toy"]
 
 
 @pytest.mark.slow
@@ -172,7 +173,7 @@ def test_toy_workflow_second_run_and_single_figure(toy_workflow, toy_distributio
     again = snakemake(directory, "-n", "--cores", "2", "--configfile", "toy.yaml", distribution=toy_distribution)
     assert "Nothing to be done" in again.stdout + again.stderr
     # the README's command (the target first: --forcerun takes every name after it)
-    forced = snakemake(directory, "results/figures/toy-force.pdf", "-n", "--configfile", "toy.yaml",
+    forced = snakemake(directory, "results/toy/figures/toy-force.pdf", "-n", "--configfile", "toy.yaml",
                        "--forcerun", "figure_toy_force", distribution=toy_distribution)
     assert planned_jobs(forced.stdout + forced.stderr) == {"figure_toy_force": 1}
 
@@ -194,16 +195,16 @@ def test_corrupted_input_gives_a_clear_error(toy_workflow, toy_distribution, tmp
     directory, _ = toy_workflow
     broken = copy_workflow(tmp_path)
     (broken / "toy.yaml").write_text(TOY_YAML)
-    sim = sorted((directory / "results" / "sim" / "toy-spring-block").glob("*.h5"))[0]
-    target = broken / "results" / "sim" / "toy-spring-block" / sim.name
+    sim = sorted((directory / "results" / "toy" / "sim" / "toy-spring-block").glob("*.h5"))[0]
+    target = broken / "results" / "toy" / "sim" / "toy-spring-block" / sim.name
     target.parent.mkdir(parents=True)
     target.write_bytes(sim.read_bytes()[:200])  # a truncated file
-    (broken / "results/sim/toy-spring-block" / f"{sim.stem}.provenance.json").write_text("{}")
-    event = f"results/events/toy-slips/toy-spring-block/{sim.stem}.h5"
+    (broken / "results/toy/sim/toy-spring-block" / f"{sim.stem}.provenance.json").write_text("{}")
+    event = f"results/toy/events/toy-slips/toy-spring-block/{sim.stem}.h5"
     result = snakemake(broken, event, "--cores", "1", "--configfile", "toy.yaml", "--allowed-rules", "events",
                        distribution=toy_distribution, check=False)
     assert result.returncode != 0
-    assert f"results/sim/toy-spring-block/{sim.name}: not a readable HDF5 file" in result.stdout + result.stderr
+    assert f"results/toy/sim/toy-spring-block/{sim.name}: not a readable HDF5 file" in result.stdout + result.stderr
     assert not (broken / event).exists()
 
 
@@ -240,5 +241,31 @@ def test_solvers_that_read_a_mesh_share_one_mesh_job():
     expected = {mesh.mesh_id(parse_params(mesh.MeshParams, {"N": N, "plates": 3})): N for N in (9, 27)}
     assert {key: value["N"] for key, value in study.meshes.items()} == expected
     inputs = [study.solver_inputs(sim.solver, sim.run_id)["mesh"] for sim in study.simulations]
-    assert sorted(set(inputs)) == sorted(f"results/mesh/{key}.h5" for key in expected)
+    assert sorted(set(inputs)) == sorted(f"results/default/mesh/{key}.h5" for key in expected)
     assert len(study.records()) == 2 + 3
+
+
+def test_study_name_is_the_config_key_else_the_config_file_stem(toy_plugins):
+    assert Study(copy.deepcopy(TOY_CONFIG), ["workflow/config/ci.yaml"]).root == "results/ci"
+    named = Study({**copy.deepcopy(TOY_CONFIG), "study": "sweep-2"}, ["ci.yaml"])
+    assert named.name == "sweep-2"
+    assert named.path("database") == "results/sweep-2/stickslip.sqlite"
+    assert named.log("sim/{solver}/{run_id}") == "results/sweep-2/logs/sim/{solver}/{run_id}.log"
+    assert all(path.startswith("results/sweep-2/") for path in named.outputs() + named.records())
+    with pytest.raises(ParameterError, match="config key study: expected a name"):
+        Study({**copy.deepcopy(TOY_CONFIG), "study": "../elsewhere"})
+
+
+@pytest.mark.slow
+def test_two_studies_in_one_clone_keep_their_results(toy_workflow, toy_distribution):
+    directory, _ = toy_workflow
+    (directory / "toy2.yaml").write_text(TOY_YAML.replace("seed: [1, 2, 3]", "seed: [4]"))
+    database = directory / "results" / "toy" / "stickslip.sqlite"
+    figure = directory / "results" / "toy" / "figures" / "toy-force.pdf"
+    before = database.read_bytes(), figure.read_bytes()
+    snakemake(directory, "--cores", "2", "--configfile", "toy2.yaml", distribution=toy_distribution)
+    assert (database.read_bytes(), figure.read_bytes()) == before
+    with sqlite3.connect(directory / "results" / "toy2" / "stickslip.sqlite") as connection:
+        assert connection.execute("SELECT COUNT(*) FROM simulations").fetchone()[0] == 1
+    again = snakemake(directory, "-n", "--cores", "2", "--configfile", "toy.yaml", distribution=toy_distribution)
+    assert "Nothing to be done" in again.stdout + again.stderr

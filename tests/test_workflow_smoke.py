@@ -14,10 +14,10 @@ from test_workflow import snakemake
 @pytest.mark.slow
 def test_ci_study_end_to_end(tmp_path):
     directory = copy_workflow(tmp_path)
-    study = Study(yaml.safe_load((REPO / "workflow" / "config" / "ci.yaml").read_text()))
+    study = Study(yaml.safe_load((REPO / "workflow" / "config" / "ci.yaml").read_text()), ["ci.yaml"])
     assert {sim.solver for sim in study.simulations} >= {"lever", "fem"}
     snakemake(directory, "--cores", "2", "--configfile", "workflow/config/ci.yaml")
-    results = directory / "results"
+    results = directory / "results" / "ci"
     for path in study.outputs():
         assert (directory / path).stat().st_size > 0, path
     records = sorted(results.rglob("*.provenance.json"))

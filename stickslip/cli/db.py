@@ -3,6 +3,8 @@
 Sub-commands: ``runs`` and ``events`` (filters, ``--format table|csv|json``),
 ``sql "SELECT ..."`` (read-only connection), ``ingest RECORD...`` (add records),
 ``rebuild`` (recreate the database from the records under the results directory).
+Each study has its own database, ``results/{study}/stickslip.sqlite``: ``--study NAME``
+chooses it (default: ``default``), ``--db FILE`` names any file.
 """
 
 import os
@@ -23,11 +25,19 @@ EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regi
                  "interface", "slip", "dmu", "multi", "time", "increment")
 
 
-def _common(parser, default_format="table"):
-    from ..provenance.query import DEFAULT_DATABASE
+def _database_options(parser):
+    parser.add_argument("--study", default="default",
+                        help="study whose database to use: results/STUDY/stickslip.sqlite (default: default)")
+    parser.add_argument("--db", type=Path, default=None, help="database file (overrides --study)")
 
-    parser.add_argument("--db", type=Path, default=Path(DEFAULT_DATABASE),
-                        help=f"database file (default {DEFAULT_DATABASE})")
+
+def _database(args):
+    """The database file of the arguments: ``--db``, else the study's."""
+    return args.db or Path("results") / args.study / "stickslip.sqlite"
+
+
+def _common(parser, default_format="table"):
+    _database_options(parser)
     parser.add_argument("--format", choices=FORMATS, default=default_format, help="output format (default table)")
     parser.add_argument("--all-columns", action="store_true", help="every column (table format shows the main ones)")
 
@@ -67,12 +77,13 @@ def add_parser(subparsers):
 
     ingest = commands.add_parser("ingest", help="add provenance records to the database (idempotent)")
     ingest.add_argument("records", nargs="+", type=Path, help="*.provenance.json files")
-    ingest.add_argument("--db", type=Path, default=None, help="database file (default results/stickslip.sqlite)")
+    _database_options(ingest)
     ingest.set_defaults(func=run_ingest)
 
     rebuild = commands.add_parser("rebuild", help="recreate the database from every record under the results")
-    rebuild.add_argument("--results", type=Path, default=Path("results"), help="results directory (default results)")
-    rebuild.add_argument("--db", type=Path, default=None, help="database file (default RESULTS/stickslip.sqlite)")
+    _database_options(rebuild)
+    rebuild.add_argument("--results", type=Path, default=None,
+                         help="results tree whose records to read (default results/STUDY)")
     rebuild.set_defaults(func=run_rebuild)
 
 
@@ -102,7 +113,7 @@ def run_runs(args):
     """``db runs``."""
     from ..provenance import query
 
-    frame = query.runs(args.db, kind=args.kind, plugin=args.plugin, solver=args.solver, n=args.n,
+    frame = query.runs(_database(args), kind=args.kind, plugin=args.plugin, solver=args.solver, n=args.n,
                        regime=args.regime, seed=args.seed)
     return _print(frame, args, RUN_COLUMNS)
 
@@ -111,7 +122,7 @@ def run_events(args):
     """``db events``."""
     from ..provenance import query
 
-    frame = query.events(args.db, solver=args.solver, analysis=args.analysis, source=args.source, n=args.n,
+    frame = query.events(_database(args), solver=args.solver, analysis=args.analysis, source=args.source, n=args.n,
                          interface=args.interface, regime=args.regime, seed=args.seed, run_id=args.run_id)
     return _print(frame, args, EVENT_COLUMNS)
 
@@ -121,7 +132,7 @@ def run_sql(args):
     from ..provenance import query
 
     try:
-        frame = query.sql(args.query, args.db)
+        frame = query.sql(args.query, _database(args))
     except query.QueryError as error:
         print(f"stickslip: error: {error}", file=sys.stderr)
         return 2
@@ -131,9 +142,8 @@ def run_sql(args):
 def run_ingest(args):
     """``db ingest``."""
     from ..provenance.ingest import ingest
-    from ..provenance.query import DEFAULT_DATABASE
 
-    counts = ingest(args.db or Path(DEFAULT_DATABASE), args.records)
+    counts = ingest(_database(args), args.records)
     print(", ".join(f"{count} {name}" for name, count in counts.items()) + " ingested")
     return 0
 
@@ -142,10 +152,11 @@ def run_rebuild(args):
     """``db rebuild``."""
     from ..provenance.ingest import find_records, ingest
 
-    records = find_records(args.results)
+    results = args.results or Path("results") / args.study
+    records = find_records(results)
     if not records:
-        raise FileFormatError(f"{args.results}: no provenance records (*.provenance.json) found")
-    database = args.db or args.results / "stickslip.sqlite"
+        raise FileFormatError(f"{results}: no provenance records (*.provenance.json) found")
+    database = args.db or results / "stickslip.sqlite"
     counts = ingest(database, records, rebuild=True)
     print(f"{database}: rebuilt from " + ", ".join(f"{count} {name}" for name, count in counts.items()))
     return 0

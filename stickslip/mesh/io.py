@@ -32,7 +32,7 @@ def mesh_id(params):
     Returns
     -------
     str
-        16 hexadecimal characters (file name ``results/mesh/{mesh_id}.h5``).
+        16 hexadecimal characters (file name ``results/{study}/mesh/{mesh_id}.h5``).
     """
     payload = {"mesh_format": MESH_FORMAT, "params": params_to_dict(params)}
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"))

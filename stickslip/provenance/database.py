@@ -1,6 +1,6 @@
 """The results database: SQLAlchemy models of runs, files, simulations, slip events and figures.
 
-One SQLite file (``results/stickslip.sqlite``) written only by the workflow's
+One SQLite file per study (``results/{study}/stickslip.sqlite``) written only by the workflow's
 ``database`` rule or ``stickslip db ingest|rebuild`` (:mod:`.ingest`); read by
 :mod:`.query`, ``stickslip db`` and any SQLite client. docs/database.md
 documents every table and column.

@@ -16,8 +16,9 @@ from .database import Figure, Run, Simulation, engine_for
 
 __all__ = ["DEFAULT_DATABASE", "QueryError", "runs", "events", "figures", "sql"]
 
-#: Where the workflow writes the database (relative to the workflow directory).
-DEFAULT_DATABASE = "results/stickslip.sqlite"
+#: Where the workflow writes the database of the default study (relative to the workflow directory);
+#: a study named S has ``results/S/stickslip.sqlite``.
+DEFAULT_DATABASE = "results/default/stickslip.sqlite"
 
 
 class QueryError(ValueError):

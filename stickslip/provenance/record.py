@@ -6,8 +6,8 @@ library versions, the host, the start and end time, the wall time, the peak
 memory, and the inputs and outputs with their sha256. It is written under a
 temporary name and renamed into place, so a reader never sees half a record.
 
-The record of ``results/sim/lever/0123456789abcdef.h5`` is
-``results/sim/lever/0123456789abcdef.provenance.json`` (:func:`record_path`).
+The record of ``results/default/sim/lever/0123456789abcdef.h5`` is
+``results/default/sim/lever/0123456789abcdef.provenance.json`` (:func:`record_path`).
 """
 
 import datetime

@@ -11,7 +11,7 @@ from snakemake.exceptions import WorkflowError
 from stickslip.params import ParameterError
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
-from stickslip.study import PATHS, Study, normalise, plugin_sections
+from stickslip.study import Study, normalise, plugin_sections
 
 
 def _validate_plugin_sections(config):
@@ -31,7 +31,7 @@ def _validate_plugin_sections(config):
 
 try:
     _validate_plugin_sections(config)
-    STUDY = Study(config)
+    STUDY = Study(config, workflow.configfiles)
 except ParameterError as error:
     raise WorkflowError(str(error)) from None
 

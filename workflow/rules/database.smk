@@ -6,9 +6,9 @@ rule database:
     input:
         STUDY.records(),
     output:
-        update(PATHS["database"]),
+        update(STUDY.path("database")),
     log:
-        "logs/database.log",
+        STUDY.log("database"),
     params:
         code=code_hash("stickslip.provenance.ingest"),
     conda:

@@ -3,12 +3,12 @@
 
 rule events:
     input:
-        PATHS["simulation"],
+        STUDY.path("simulation"),
     output:
-        h5=PATHS["events"],
-        record=record_of(PATHS["events"]),
+        h5=STUDY.path("events"),
+        record=record_of(STUDY.path("events")),
     log:
-        "logs/events/{analysis}/{solver}/{run_id}.log",
+        STUDY.log("events/{analysis}/{solver}/{run_id}"),
     params:
         params=lambda wildcards: Study.dumps(STUDY.analyses[wildcards.analysis]),
         code=lambda wildcards: Study.code("analysis", wildcards.analysis),

@@ -15,7 +15,7 @@ for _figure, _job in STUDY.figures.items():
                        labels={"figure": _figure, "format": "PNG"}),
             record=record_of(_job.path),
         log:
-            f"logs/figures/{_figure}.log",
+            STUDY.log(f"figures/{_figure}"),
         params:
             figure=_figure,
             params=Study.dumps(_job.params),

@@ -3,10 +3,10 @@
 
 rule mesh:
     output:
-        h5=PATHS["mesh"],
-        record=record_of(PATHS["mesh"]),
+        h5=STUDY.path("mesh"),
+        record=record_of(STUDY.path("mesh")),
     log:
-        "logs/mesh/{mesh_id}.log",
+        STUDY.log("mesh/{mesh_id}"),
     params:
         params=lambda wildcards: Study.dumps(STUDY.meshes[wildcards.mesh_id]),
         code=Study.code("mesh", "mesh") if STUDY.meshes else "",

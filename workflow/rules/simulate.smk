@@ -5,12 +5,12 @@ rule simulate:
     input:
         unpack(lambda wildcards: STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
     output:
-        h5=PATHS["simulation"],
-        record=record_of(PATHS["simulation"]),
+        h5=STUDY.path("simulation"),
+        record=record_of(STUDY.path("simulation")),
     log:
-        "logs/sim/{solver}/{run_id}.log",
+        STUDY.log("sim/{solver}/{run_id}"),
     benchmark:
-        "logs/benchmarks/sim/{solver}/{run_id}.tsv"
+        STUDY.path("benchmark")
     threads: STUDY.threads
     params:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
