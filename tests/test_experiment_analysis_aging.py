@@ -70,3 +70,42 @@ def test_slow_slip_fraction_and_subset():
     np.testing.assert_allclose(aging.slow_slip_fraction([6.0, 4.0, 0.0], [4.5, 4.0, 0.0]), [0.25, 0.0, np.nan])
     slips = pd.DataFrame({"drift": [0.0, 0.0029, 0.003, 0.01, np.nan]})
     assert aging.without_slow_slip(slips).index.tolist() == [0, 1]
+
+
+def test_intercept_fit_recovers_an_offset_that_the_origin_fit_reads_as_aging():
+    """dmu = c + B ln T: the intercept fit finds B and c within their errors; the paper's fit through
+    the origin returns B + c / <ln T> (here 0.03 + 0.08 / ~4 = ~0.05)."""
+    B, c = 0.03, 0.08
+    T, dmu = _aging_sample(B, 0.02, 2000, 7)
+    dmu = dmu + c
+    free = aging.fit_aging(T, dmu, fit="intercept")
+    assert abs(free.B - B) < 4 * free.B_error and free.B_error < 0.05 * B
+    assert abs(free.c - c) < 4 * free.c_error and free.c_error < 0.05 * c
+    origin = aging.fit_aging(T, dmu, fit="origin")
+    assert origin.c == 0.0 and origin.c_error == 0.0
+    x = np.log(T).mean()
+    assert origin.B == pytest.approx(B + c / x, rel=0.1)
+    assert origin.B > 1.5 * B
+    np.testing.assert_allclose(free([1.0, np.e]), [free.c, free.c + free.B])
+
+
+def test_intercept_fit_needs_three_bins_and_a_known_kind():
+    T = np.repeat([2.0, 20.0], 10)
+    with pytest.raises(ValueError, match="at least three bins"):
+        aging.fit_aging(T, 0.05 * np.log(T) + 0.01 * np.arange(20) % 3, fit="intercept")
+    with pytest.raises(ValueError, match="fit must be one of origin, intercept"):
+        aging.fit_aging(T, T, fit="free")
+
+
+def test_per_interface_fits_recover_each_rate():
+    rng = np.random.default_rng(3)
+    rates = {1: 0.02, 2: 0.05}
+    rows = []
+    for a, B in rates.items():
+        T = 10.0 ** rng.uniform(0.5, 3.0, 800)
+        rows.append(pd.DataFrame({"a": a, "T": T, "dmu": 0.1 + B * np.log(T) + rng.normal(0, 0.01, T.size)}))
+    fits = aging.fit_aging_per_interface(pd.concat(rows), fit="intercept")
+    assert sorted(fits) == [1, 2]
+    for a, B in rates.items():
+        assert abs(fits[a].B - B) < 4 * fits[a].B_error
+        assert abs(fits[a].c - 0.1) < 4 * fits[a].c_error

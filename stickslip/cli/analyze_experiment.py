@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..experiment.aging import fit_aging
+from ..experiment.aging import FITS, fit_aging, fit_aging_per_interface
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
 from ..experiment.timeseries import read_timeseries
 from ..params import ParameterError, parse_assignments, parse_params
@@ -17,11 +17,19 @@ def add_parser(subparsers):
         description="Detect every slip of one or more experimental time-series files (lab or `lever` runs), "
                     "write one row per slip to CSV (columns t [s], a, n, protocol, dF [N], dmu, T [s], dR [mm], "
                     "dR_from_dF [mm], B_a, multi, ...) and/or fit the aging law dmu = B ln(T/T0) on all single "
-                    "slips with a waiting time.")
+                    "slips with a waiting time: through the origin (the paper's fit) or with a free intercept c "
+                    "(dmu = c + B ln(T/T0)), over all interfaces or per interface.")
     parser.add_argument("runs", nargs="+", type=Path, metavar="RUN.h5", help="time-series files")
     parser.add_argument("-o", "--output", type=Path, help="CSV file of the slips")
     parser.add_argument("--aging", action="store_true",
-                        help="fit the aging law; the last line printed is `B=<value> +- <error>`")
+                        help="fit the aging law; the last line printed is `B=<value> +- <error>` (origin) or "
+                             "`B=<value> +- <error> c=<value> +- <error>` (intercept)")
+    parser.add_argument("--fit", choices=FITS, default="origin",
+                        help="aging law: through the origin dmu = B ln(T/T0) (the paper's) or with a free "
+                             "intercept dmu = c + B ln(T/T0) (default: origin)")
+    parser.add_argument("--per-interface", action="store_true",
+                        help="fit each interface separately: one line `a=<i> B=<value> +- <error> c=<value> "
+                             "+- <error>` per interface (c = 0 through the origin)")
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                         help="analysis parameter (repeat); see `stickslip plugins --params`")
     parser.set_defaults(func=run)
@@ -43,10 +51,23 @@ def run(args):
         slips.to_csv(args.output, index=False)
         print(f"{len(slips)} slips ({int(slips['multi'].sum())} in multi-interface events) -> {args.output}")
     if args.aging:
-        try:
-            fit = fit_aging(slips["T"], slips["dmu"], t0=params.t0)
-        except ValueError as error:
-            raise ParameterError(f"aging fit: {error}") from None
-        print(f"aging fit on {fit.n_slips} slips in {len(fit.bins)} logarithmic bins of T (T0 = {params.t0} s)")
-        print(f"B={fit.B:.4g} +- {fit.B_error:.2g}")
+        single = slips[~slips["multi"].to_numpy(dtype=bool)]
+        print(f"aging fit ({args.fit}) on the single slips in logarithmic bins of T (T0 = {params.t0} s)")
+        if args.per_interface:
+            for a, fit in fit_aging_per_interface(single, t0=params.t0, fit=args.fit).items():
+                print(f"a={a} " + (_fit_line(fit, intercept=True) if not isinstance(fit, ValueError)
+                                   else f"no fit: {fit}"))
+        else:
+            try:
+                fit = fit_aging(single["T"], single["dmu"], t0=params.t0, fit=args.fit)
+            except ValueError as error:
+                raise ParameterError(f"aging fit: {error}") from None
+            print(f"{fit.n_slips} slips in {len(fit.bins)} bins")
+            print(_fit_line(fit, intercept=args.fit == "intercept"))
     return 0
+
+
+def _fit_line(fit, *, intercept):
+    """``B=<value> +- <error>``, followed by ``c=<value> +- <error>`` if ``intercept``."""
+    line = f"B={fit.B:.4g} +- {fit.B_error:.2g}"
+    return line + f" c={fit.c:.4g} +- {fit.c_error:.2g}" if intercept else line

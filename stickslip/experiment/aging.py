@@ -17,18 +17,21 @@ import dataclasses
 import numpy as np
 import pandas as pd
 
-__all__ = ["T0", "SLOW_SLIP_DRIFT", "AgingFit", "log_binned", "fit_aging", "aging_rate", "spread_of_aging_rate",
-           "slow_slip_fraction", "without_slow_slip"]
+__all__ = ["T0", "SLOW_SLIP_DRIFT", "FITS", "AgingFit", "log_binned", "fit_aging", "fit_aging_per_interface",
+           "aging_rate", "spread_of_aging_rate", "slow_slip_fraction", "without_slow_slip"]
 
 #: Microscopic time scale of the aging law [s].
 T0 = 1.0
 #: Drift of an interface between two of its slips above which slow slip occurred [mm] (3 um).
 SLOW_SLIP_DRIFT = 3e-3
+#: Aging fits: the paper's line through the origin ``dmu = B ln(T/T0)``, and a free intercept
+#: ``dmu = c + B ln(T/T0)``.
+FITS = ("origin", "intercept")
 
 
 @dataclasses.dataclass(frozen=True)
 class AgingFit:
-    """Result of the aging fit ``dmu = B ln(T / T0)``.
+    """Result of the aging fit ``dmu = c + B ln(T / T0)`` (``c = 0`` through the origin).
 
     Attributes
     ----------
@@ -36,6 +39,12 @@ class AgingFit:
         Aging rate [-].
     B_error : float
         Its standard error [-].
+    c : float
+        Intercept, the friction drop at ``T = T0`` [-] (0 for the fit through the origin).
+    c_error : float
+        Its standard error [-] (0 for the fit through the origin).
+    kind : {"origin", "intercept"}
+        Which fit (:data:`FITS`).
     bins : pandas.DataFrame
         One row per bin used: ``T_low``, ``T_high`` [s] (edges), ``T`` [s] (geometric mean of the
         bin's ``T``), ``dmu_mean``, ``dmu_std`` [-], ``count``.
@@ -45,8 +54,15 @@ class AgingFit:
 
     B: float
     B_error: float
+    c: float
+    c_error: float
+    kind: str
     bins: pd.DataFrame
     n_slips: int
+
+    def __call__(self, T, t0=T0):
+        """The fitted law ``c + B ln(T / t0)`` at waiting times ``T`` [s] (any shape)."""
+        return self.c + self.B * np.log(np.asarray(T, dtype=float) / t0)
 
 
 def log_binned(T, values, *, bins_per_decade=4, min_count=5):
@@ -87,14 +103,21 @@ def log_binned(T, values, *, bins_per_decade=4, min_count=5):
     return pd.DataFrame(rows, columns=columns)
 
 
-def fit_aging(T, dmu, *, t0=T0, bins_per_decade=4, min_count=5):
-    """Fit ``dmu = B ln(T / t0)`` on logarithmically binned waiting times.
+def fit_aging(T, dmu, *, t0=T0, fit="origin", bins_per_decade=4, min_count=5):
+    """Fit ``dmu = B ln(T / t0)`` (``fit="origin"``) or ``dmu = c + B ln(T / t0)`` (``"intercept"``)
+    on logarithmically binned waiting times.
 
-    The bin means ``y_k`` at ``x_k = mean(ln(T / t0))`` of bin ``k`` are fitted by weighted least
-    squares through the origin, weights ``w_k = count_k / std_k**2`` (inverse variance of a bin
-    mean): ``B = sum(w x y) / sum(w x^2)``. The standard error is scaled by the reduced
-    chi-square of the fit, ``B_error = sqrt(chi2 / (m - 1) / sum(w x^2))`` (``m`` bins), so that it
-    reflects the actual scatter of the bin means around the law.
+    The bin means ``y_k`` at ``x_k = mean(ln(T / t0))`` of bin ``k`` are fitted by weighted linear
+    least squares, weights ``w_k = count_k / std_k**2`` (inverse variance of a bin mean), design
+    matrix ``X = [x]`` (origin, the paper's fit) or ``[x, 1]`` (intercept). The covariance
+    ``(X^T W X)^-1`` is scaled by the reduced chi-square ``chi2 / (m - p)`` (``m`` bins, ``p``
+    parameters), so that the errors reflect the actual scatter of the bin means around the law.
+    Through the origin this is ``B = sum(w x y) / sum(w x^2)``,
+    ``B_error = sqrt(chi2 / (m - 1) / sum(w x^2))``.
+
+    A strength offset (friction drop gained however short the stick, ``dmu = c + B ln T``) is
+    read by the fit through the origin as extra aging: over the ``T`` range of the data the
+    origin fit returns ``B + c / <x>`` roughly; the intercept fit returns ``B`` and ``c``.
 
     Parameters
     ----------
@@ -104,6 +127,8 @@ def fit_aging(T, dmu, *, t0=T0, bins_per_decade=4, min_count=5):
         Friction drop of the slip [-].
     t0 : float
         Microscopic time scale [s].
+    fit : {"origin", "intercept"}
+        Law fitted (:data:`FITS`).
     bins_per_decade, min_count : int
         See :func:`log_binned`.
 
@@ -114,21 +139,54 @@ def fit_aging(T, dmu, *, t0=T0, bins_per_decade=4, min_count=5):
     Raises
     ------
     ValueError
-        If fewer than two bins hold ``min_count`` slips.
+        If fewer than ``p + 1`` bins hold ``min_count`` slips (2 through the origin, 3 with an
+        intercept), or ``fit`` is unknown.
     """
+    if fit not in FITS:
+        raise ValueError(f"fit must be one of {', '.join(FITS)}; got {fit!r}")
+    n_params = FITS.index(fit) + 1
     bins = log_binned(T, dmu, bins_per_decade=bins_per_decade, min_count=min_count)
-    if len(bins) < 2:
-        raise ValueError(f"aging fit needs at least two bins of {min_count} slips with a waiting time; "
-                         f"got {len(bins)}")
+    if len(bins) < n_params + 1:
+        raise ValueError(f"aging fit ({fit}) needs at least {('two', 'three')[n_params - 1]} bins of {min_count} slips with a "
+                         f"waiting time; got {len(bins)}")
     x = np.log(bins["T"].to_numpy() / t0)  # the geometric mean: x = mean(ln(T / t0)) per bin
     y = bins["dmu_mean"].to_numpy()
     std = np.maximum(bins["dmu_std"].to_numpy(), np.finfo(float).tiny)
     w = bins["count"].to_numpy() / std ** 2
-    curvature = np.sum(w * x * x)
-    B = float(np.sum(w * x * y) / curvature)
-    chi2 = float(np.sum(w * (y - B * x) ** 2))
-    B_error = float(np.sqrt(chi2 / (len(bins) - 1) / curvature))
-    return AgingFit(B=B, B_error=B_error, bins=bins, n_slips=int(bins["count"].sum()))
+    design = np.column_stack([x, np.ones_like(x)][:n_params])
+    normal = design.T @ (w[:, None] * design)
+    coefficients = np.linalg.solve(normal, design.T @ (w * y))
+    chi2 = float(np.sum(w * (y - design @ coefficients) ** 2))
+    errors = np.sqrt(np.diag(np.linalg.inv(normal)) * chi2 / (len(bins) - n_params))
+    c, c_error = (float(coefficients[1]), float(errors[1])) if n_params == 2 else (0.0, 0.0)
+    return AgingFit(B=float(coefficients[0]), B_error=float(errors[0]), c=c, c_error=c_error, kind=fit,
+                    bins=bins, n_slips=int(bins["count"].sum()))
+
+
+def fit_aging_per_interface(slips, *, t0=T0, fit="origin", bins_per_decade=4, min_count=5):
+    """:func:`fit_aging` on the slips of each interface separately.
+
+    Parameters
+    ----------
+    slips : pandas.DataFrame
+        Columns ``a``, ``T`` [s], ``dmu`` (rows with NaN are ignored).
+    t0, fit, bins_per_decade, min_count
+        See :func:`fit_aging`.
+
+    Returns
+    -------
+    dict[int, AgingFit or ValueError]
+        Per interface (sorted), the fit, or the error that says why it could not be made
+        (too few bins).
+    """
+    results = {}
+    for a, part in slips.groupby("a", sort=True):
+        try:
+            results[int(a)] = fit_aging(part["T"], part["dmu"], t0=t0, fit=fit, bins_per_decade=bins_per_decade,
+                                        min_count=min_count)
+        except ValueError as error:
+            results[int(a)] = error
+    return results
 
 
 def aging_rate(dmu, T, *, t0=T0):

@@ -101,11 +101,13 @@ def aging_panel(ax, slips, *, color_by="a", t0=aging.T0, fit=True):
     t0 : float
         Aging time scale [s].
     fit : bool
-        Draw the binned means (black, error bar = standard deviation) and the fitted law.
+        Draw the binned means (black, error bar = standard deviation), the paper's fit through the
+        origin (dotted) and the fit with a free intercept ``c`` (dashed, if there are three bins).
 
     Returns
     -------
     stickslip.experiment.aging.AgingFit or None
+        The fit through the origin.
     """
     data = single_slips(slips)
     data = data[np.isfinite(data["T"].to_numpy(dtype=float)) & np.isfinite(data["dmu"].to_numpy(dtype=float))]
@@ -139,8 +141,14 @@ def aging_panel(ax, slips, *, color_by="a", t0=aging.T0, fit=True):
     ax.errorbar(bins["T"], bins["dmu_mean"], yerr=bins["dmu_std"], color="black", marker="s", markersize=4,
                 linestyle="none", capsize=2, zorder=5)
     T = np.logspace(np.log10(max(t0, bins["T_low"].min())), np.log10(bins["T_high"].max()), 50)
-    ax.plot(T, result.B * np.log(T / t0), color="black", linestyle=":", zorder=6,
+    ax.plot(T, result(T, t0), color="black", linestyle=":", zorder=6,
             label=rf"$B = {result.B:.3f} \pm {result.B_error:.3f}$")
+    try:
+        free = aging.fit_aging(data["T"], data["dmu"], t0=t0, fit="intercept")
+    except ValueError:
+        return result
+    ax.plot(T, free(T, t0), color="black", linestyle="--", linewidth=0.8, zorder=6,
+            label=rf"$B = {free.B:.3f} \pm {free.B_error:.3f}$, $c = {free.c:.3f} \pm {free.c_error:.3f}$")
     return result
 
 
