@@ -12,7 +12,7 @@ from .plotting import a_style, label_panels
 from .experimental_panels import LABELS, aging_panel, disorder_law_lines, distributions_by_n, log_edges, single_slips
 from .style import plt, save_figure
 
-VERSION = "1"
+VERSION = "2"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -11,7 +11,7 @@ from .plotting import individual_style, label_panels
 from .experimental_panels import aging_panel, disorder_law_lines, single_slips
 from .style import plt, save_figure
 
-VERSION = "1"
+VERSION = "2"
 
 
 @dataclasses.dataclass(frozen=True)
