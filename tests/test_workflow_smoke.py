@@ -20,6 +20,14 @@ def test_ci_study_end_to_end(tmp_path):
     results = directory / "results" / "ci"
     for path in study.outputs():
         assert (directory / path).stat().st_size > 0, path
+    # every job's log shows its progress, ending with the whole work done
+    for sim in study.simulations:
+        log = (directory / study.log(f"sim/{sim.solver}/{sim.run_id}")).read_text()
+        done = {"fem": "fem increments: 200/200 increment (100%)",
+                "lever": f"virtual experiment: {sim.params['duration']:.0f}/{sim.params['duration']:.0f} s simulated (100%)"}
+        assert done[sim.solver] in log, log
+    records_count = len(study.records())
+    assert f"ingest: {records_count}/{records_count} record (100%)" in (directory / study.log("database")).read_text()
     records = sorted(results.rglob("*.provenance.json"))
     assert [p.relative_to(directory).as_posix() for p in records] == study.records()
     for path in records:

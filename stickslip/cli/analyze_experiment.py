@@ -8,6 +8,7 @@ from ..experiment.aging import FITS, fit_aging, fit_aging_per_interface
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
 from ..experiment.timeseries import read_timeseries
 from ..params import ParameterError, parse_assignments, parse_params
+from ..progress import iterate
 
 
 def add_parser(subparsers):
@@ -42,7 +43,7 @@ def run(args):
     params = parse_params(ExperimentEventsParams, parse_assignments(args.param),
                           owner="analysis 'experiment-events'")
     tables = []
-    for path in args.runs:
+    for path in iterate(args.runs, desc="analyze-experiment", unit="run"):
         slips, _ = analyse_record(read_timeseries(path), params)
         tables.append(slips.assign(run=str(path)))
     slips = pd.concat(tables, ignore_index=True)

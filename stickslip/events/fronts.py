@@ -28,6 +28,7 @@ from .. import h5io
 from ..h5io import FileFormatError
 from ..mesh import load_mesh
 from ..params import ParameterError, param
+from ..progress import iterate
 from ..registry import register
 from . import extraction
 from .plugin import event_attrs
@@ -243,7 +244,7 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
     n = len(extraction.interfaces_in(classified))
     kinds = ("multi",) if params.events == "multi" else ("single", "multi")
     chosen = multi_slip_increments(classified, params.max_events, kinds) if params.interfaces in (0, n) else []
-    for increment in chosen:
+    for increment in iterate(chosen, desc="front-dynamics events", unit="event"):
         events = rerun(int(increment))
         _check_failures(events, f"re-run of increment {increment}")
         events = events[list(FAILURE_COLUMNS)].sort_values(["t", "a", "block"], kind="stable")

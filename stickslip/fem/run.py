@@ -9,12 +9,18 @@ is marked completed, when a block comes within ``margin`` wells of the end of
 its yield strains (during a minimisation, or after a load step), or after
 ``max_increments`` increments. Every increment is appended and flushed; an
 interrupted run resumes from its last complete increment and gives the same
-file contents as an uninterrupted run.
+file contents as an uninterrupted run. Progress (increments, slip events so far,
+increments/s, time left when ``max_increments`` bounds the run) goes to stderr
+through :mod:`stickslip.progress`.
 Reference: shared/reference-model.md, section 8c.
 """
 
+import json
 from pathlib import Path
 
+import numpy as np
+
+from .. import progress
 from ..h5io import FileFormatError, atomic_output, open_file
 from ..params import params_to_dict
 from .minimise import within_margin
@@ -29,6 +35,31 @@ def _row(observer, increment, kick, yield_element, previous_index):
     row = {"increment": increment, "kick": kick, "yield_element": yield_element}
     row.update(observer.observe(previous_index))
     return row
+
+
+class _Progress:
+    """Progress of the increment loop: increments stored and slip events so far.
+
+    A slip event is an increment in which every one of the ``N`` blocks of some interface
+    changed well (``A_a == N``, :mod:`stickslip.events.extraction`).
+    """
+
+    def __init__(self, file, params, increment):
+        self.N = params.N
+        self.slips = self._slips(file, 0)
+        self.bar = progress.bar(params.max_increments or None, desc="fem increments", unit="increment",
+                                initial=increment, postfix=f"slips {self.slips}")
+
+    def _slips(self, file, first):
+        table = file["increments"]
+        A = [table[name][first:] for name in json.loads(table.attrs["columns"]) if name.startswith("A_a")]
+        return int(np.count_nonzero(np.any(np.asarray(A) == self.N, axis=0)))
+
+    def stored(self, file, increment):
+        """Count increment ``increment``, just appended to ``file``."""
+        self.slips += self._slips(file, increment)
+        self.bar.set_postfix_str(f"slips {self.slips}", refresh=False)
+        self.bar.update(1)
 
 
 def _create(path, params, mesh, threads):
@@ -84,6 +115,7 @@ def run_simulation(params, output, mesh, threads=1):
         previous_index = observer.well_index()
         new = 0
         reason = ""
+        report = _Progress(file, params, increment)
         while not reason:
             if params.max_increments and increment >= params.max_increments:
                 reason = "max_increments"
@@ -104,6 +136,8 @@ def run_simulation(params, output, mesh, threads=1):
             append_increment(file, system, _row(observer, increment, kick, yield_element, previous_index))
             previous_index = observer.well_index()
             new += 1
+            report.stored(file, increment)
+        report.bar.close()
         file.attrs["completed"] = True
         file.attrs["stop_reason"] = reason
         return new

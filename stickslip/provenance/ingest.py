@@ -27,6 +27,7 @@ from sqlalchemy import delete, insert, text
 from sqlalchemy.orm import Session
 
 from ..h5io import open_file, read_table
+from ..progress import iterate
 from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
 
@@ -244,7 +245,7 @@ def ingest(database, records, *, rebuild=False):
                 events = 0
                 with Session(engine) as session, session.begin():
                     regimes = {}
-                    for record_file in records:
+                    for record_file in iterate(records, desc="ingest", unit="record"):
                         added, found = _ingest_record(session, read_record(record_file), record_file)
                         events += added
                         regimes.update(found)

@@ -26,6 +26,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from ...progress import bar
 from .friction import first_crossing
 
 __all__ = ["SlipHistory", "integrate"]
@@ -144,6 +145,8 @@ def integrate(apparatus, law, duration, slip_duration, rng):
     rows, creep_rows = [], []
     event = 0
 
+    report = bar(math.ceil(duration), desc="virtual experiment", unit="s simulated")  # whole seconds
+
     def stop_creep(at):
         for i in np.flatnonzero(creeping):
             creep_rows.append((i + 1, creep_start[i], at, law.creep_velocity[i]))
@@ -167,6 +170,7 @@ def integrate(apparatus, law, duration, slip_duration, rng):
         R += velocity * tau
         creep_since_slip += velocity * tau
         t += tau
+        report.update(math.floor(min(t, duration)) - report.n)
         if kind == "end":
             break
         if kind == "creep":
@@ -192,6 +196,8 @@ def integrate(apparatus, law, duration, slip_duration, rng):
         event += 1
         t += slip_duration
     stop_creep(min(t, duration))
+    report.update(report.total - report.n)
+    report.close()
     slips = pd.DataFrame(rows, columns=list(SLIP_COLUMNS))
     creep = pd.DataFrame(creep_rows, columns=["a", "t_on", "t_off", "velocity"])
     return SlipHistory(R0=R0, slips=slips, creep=creep, slip_duration=slip_duration, duration=duration)
