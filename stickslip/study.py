@@ -13,8 +13,8 @@ Config layout (``workflow/config/*.yaml``, schema ``workflow/schemas/config.sche
     figures:                        # figure name -> parameters
       fig3: {}
 
-A run's parameters are its sweep's ``params`` overridden by one combination of
-its ``grid``; its id is :func:`stickslip.registry.run_id` of those parameters.
+A run's parameters are its sweep's ``params`` and one combination of its
+``grid`` (a parameter is named in one of the two, a grid value listed once); its id is :func:`stickslip.registry.run_id` of those parameters.
 An analysis runs on every simulation of the solvers it accepts; a figure reads
 every output of each input category it declares (``solver:<name>``,
 ``analysis:<name>``, ``mesh``).
@@ -213,6 +213,19 @@ def _parse(plugin, values, where):
         raise ParameterError(f"config {where}: {error}") from None
 
 
+def _check_sweep(params, grid, where):
+    """Refuse a parameter given in both ``params`` and ``grid``, and a grid value listed twice."""
+    both = sorted(set(params) & set(grid))
+    if both:
+        raise ParameterError(f"config {where}: parameter '{both[0]}' is in both params ({params[both[0]]!r}) and "
+                             f"grid ({grid[both[0]]!r}); expected it in one of them")
+    for key, values in grid.items():
+        for j, value in enumerate(values):
+            if value in values[:j]:
+                raise ParameterError(f"config {where}.grid.{key}: value {value!r} is listed twice; expected "
+                                     "each value once")
+
+
 def _mesh_for(params):
     """Return (mesh_id, mesh parameters) for a solver run: the solver's fields named as MeshParams fields."""
     from . import mesh
@@ -276,6 +289,7 @@ class Study:
                                      f"{', '.join(unknown)} that solver '{name}' declares (it makes: mesh)")
             for i, sweep in enumerate(sweeps):
                 grid = sweep.get("grid") or {}
+                _check_sweep(sweep.get("params") or {}, grid, _where("solvers", name, f"[{i}]"))
                 keys = list(grid)
                 for combination in itertools.product(*(grid[k] for k in keys)):
                     values = {**(sweep.get("params") or {}), **dict(zip(keys, combination))}

@@ -89,6 +89,8 @@ CORRUPTIONS = [
     (lambda f: f.__delitem__("x"), "'x' is missing (required dataset)"),
     (lambda f: f.attrs.__delitem__("k_spring"), "'k_spring' is missing (required attribute)"),
     (lambda f: f.attrs.__setitem__("n", 1.5), "'n' must be an integer"),
+    (lambda f: (f.attrs.__setitem__("protocol", "individual"), f.attrs.__delitem__("a")),
+     "'a' is missing (required attribute of the individual protocol: the driven slab)"),
     (lambda f: f.attrs.__setitem__("h", "ten"), "'h' must be a number"),
     (lambda f: f.attrs.__setitem__("protocol", "free"), "'protocol' must be one of"),
     (lambda f: f["t_F"].__setitem__(3, 0.0), "'t_F' must be strictly increasing; sample 3"),
@@ -102,6 +104,28 @@ def test_reader_names_the_bad_item(tmp_path, edit, message):
     with pytest.raises(FileFormatError, match=re.escape(message)) as error:
         read_timeseries(tmp_path / "run.h5")
     assert str(tmp_path / "run.h5") in str(error.value)
+
+
+def test_a_stack_recording_without_a_is_read_and_analysed(tmp_path):
+    """Lab exports of the stack protocol carry no driven-slab attribute: read as a = 0, analysed as with it."""
+    from stickslip.cli import main
+    from stickslip.solvers import lever
+
+    with_a, without_a = tmp_path / "with_a.h5", tmp_path / "without_a.h5"
+    signals, _, _ = lever.simulate(lever.LeverParams(n=2, duration=600.0, seed=1))
+    for path in (with_a, without_a):
+        write_timeseries(path, signals)
+    with h5py.File(without_a, "r+") as f:
+        del f.attrs["a"]
+    read = [read_timeseries(path) for path in (with_a, without_a)]
+    assert read[1].a == 0
+    for field in dataclasses.fields(ExperimentRecord):
+        np.testing.assert_array_equal(getattr(read[1], field.name), getattr(read[0], field.name))
+    for path in (with_a, without_a):
+        assert main(["analyze-experiment", str(path), "-o", str(path.with_suffix(".csv"))]) == 0
+    slips = [pd.read_csv(path.with_suffix(".csv")).drop(columns="run") for path in (with_a, without_a)]
+    assert len(slips[0]) > 0
+    pd.testing.assert_frame_equal(slips[0], slips[1])
 
 
 def test_reader_rejects_missing_and_non_hdf5_files(tmp_path):

@@ -72,6 +72,11 @@ def test_study_expands_grids_and_resolves_inputs(toy_plugins):
      r"config solvers.toy-spring-block\[0\]: parameter 'seed': expected an integer, got 'x'"),
     (lambda c: c["solvers"]["toy-spring-block"][1]["params"].update(F_d=0.95),
      r"config solvers.toy-spring-block\[1\]: parameter 'F_d': must be below"),
+    (lambda c: c["solvers"]["toy-spring-block"][0]["params"].update(seed=4),
+     r"config solvers.toy-spring-block\[0\]: parameter 'seed' is in both params \(4\) and grid \(\[1, 2, 3\]\); "
+     r"expected it in one of them"),
+    (lambda c: c["solvers"]["toy-spring-block"][0]["grid"].update(seed=[1, 2, 1]),
+     r"config solvers.toy-spring-block\[0\].grid.seed: value 1 is listed twice; expected each value once"),
     (lambda c: c["solvers"].update(nope=[]), r"config solvers.nope: unknown solver 'nope'"),
     (lambda c: c["figures"].update({"toy-force": {"height": 1}}), r"config figures.toy-force: unknown parameter"),
     (lambda c: c["solvers"].pop("toy-spring-block"), r"config analyses.toy-slips: it reads outputs"),
@@ -123,6 +128,11 @@ def test_bad_config_value_stops_before_any_job(tmp_path, toy_distribution):
     result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
     assert result.returncode != 0
     assert "Additional properties are not allowed ('thread' was unexpected)" in result.stdout + result.stderr
+    (tmp_path / "bad.yaml").write_text(TOY_YAML.replace("params: {slips: 4}", "params: {slips: 4, seed: 2}"))
+    result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
+    assert result.returncode != 0
+    assert ("config solvers.toy-spring-block[0]: parameter 'seed' is in both params (2) and grid ([1, 2, 3])"
+            in result.stdout + result.stderr)
     assert not (tmp_path / "results").exists()
 
 

@@ -13,7 +13,7 @@ item             shape / type        meaning
 attr ``n``       int                 driven slabs (springs attached), 1..n_slabs
 attr ``n_slabs`` int                 slabs in the stack
 attr ``protocol`` str                ``"stack"`` or ``"individual"``
-attr ``a``       int                 slab driven alone (individual), 0 for stack
+attr ``a``       int                 slab driven alone (individual); stack: 0 or absent
 attr ``normal_force`` float          N [N]
 attr ``k_spring`` float              K [N/mm]
 attr ``h``       float               slab thickness [mm]
@@ -236,7 +236,8 @@ def read_timeseries(path):
     stickslip.h5io.FileFormatError
         If the file is missing or unreadable, a required dataset or attribute is
         absent or of the wrong kind, or the content fails :func:`validate_record`;
-        the message names the file and the item.
+        the message names the file and the item. (``a`` is required for the
+        individual protocol only; a stack recording without it reads as ``a = 0``.)
     """
     source = str(path)
     values = {}
@@ -248,11 +249,15 @@ def read_timeseries(path):
             if data.dtype.kind not in "fiu":
                 _fail(source, name, f"must be numeric, got dtype {data.dtype}")
             values[name] = np.asarray(data, dtype=np.float64)
-        for name in _INT_ATTRS + _FLOAT_ATTRS + ("protocol",):
-            if name not in f.attrs:
+        for name in ("protocol",) + _INT_ATTRS + _FLOAT_ATTRS:
+            if name not in f.attrs and name != "a":
                 _fail(source, name, "is missing (required attribute)")
+        protocol = f.attrs["protocol"]
+        values["protocol"] = protocol.decode() if isinstance(protocol, bytes) else str(protocol)
+        if "a" not in f.attrs and values["protocol"] == "individual":
+            _fail(source, "a", "is missing (required attribute of the individual protocol: the driven slab)")
         for name in _INT_ATTRS:
-            value = f.attrs[name]
+            value = f.attrs.get(name, 0)  # only a of a stack recording may be absent: 0
             if not (np.issubdtype(type(value), np.integer) or (isinstance(value, float) and value.is_integer())):
                 _fail(source, name, f"must be an integer, got {value!r}")
             values[name] = int(value)
@@ -261,8 +266,6 @@ def read_timeseries(path):
             if not np.issubdtype(type(value), np.number) or np.ndim(value) != 0:
                 _fail(source, name, f"must be a number, got {value!r}")
             values[name] = float(value)
-        protocol = f.attrs["protocol"]
-        values["protocol"] = protocol.decode() if isinstance(protocol, bytes) else str(protocol)
     record = ExperimentRecord(**values)
     validate_record(record, source=source)
     return record
