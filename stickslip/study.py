@@ -14,7 +14,8 @@ Config layout (``workflow/config/*.yaml``, schema ``workflow/schemas/config.sche
       fig3: {}
 
 A run's parameters are its sweep's ``params`` and one combination of its
-``grid`` (a parameter is named in one of the two, a grid value listed once); its id is :func:`stickslip.registry.run_id` of those parameters.
+``grid`` (a parameter is named in one of the two, a grid value listed once:
+:func:`check_sweeps`); its id is :func:`stickslip.registry.run_id` of those parameters.
 An analysis runs on every simulation of the solvers it accepts; a figure reads
 every output of each input category it declares (``solver:<name>``,
 ``analysis:<name>``, ``mesh``).
@@ -36,7 +37,7 @@ from .provenance.code import code_hash
 from .provenance.record import record_path
 
 __all__ = ["RESULTS", "PATHS", "study_name", "Simulation", "AnalysisJob", "FigureJob", "Study", "plugin_sections",
-           "normalise"]
+           "normalise", "check_sweeps"]
 
 #: Directory of the studies' results trees (relative to the workflow's working directory).
 RESULTS = "results"
@@ -213,17 +214,34 @@ def _parse(plugin, values, where):
         raise ParameterError(f"config {where}: {error}") from None
 
 
-def _check_sweep(params, grid, where):
-    """Refuse a parameter given in both ``params`` and ``grid``, and a grid value listed twice."""
-    both = sorted(set(params) & set(grid))
-    if both:
-        raise ParameterError(f"config {where}: parameter '{both[0]}' is in both params ({params[both[0]]!r}) and "
-                             f"grid ({grid[both[0]]!r}); expected it in one of them")
-    for key, values in grid.items():
-        for j, value in enumerate(values):
-            if value in values[:j]:
-                raise ParameterError(f"config {where}.grid.{key}: value {value!r} is listed twice; expected "
-                                     "each value once")
+def check_sweeps(config):
+    """Refuse a parameter given in both ``params`` and ``grid`` of a sweep, and a grid value listed twice.
+
+    Call it on the config as read, before a schema validator fills the defaults into ``params``.
+
+    Parameters
+    ----------
+    config : dict
+        The workflow config (checked against the config schema).
+
+    Raises
+    ------
+    ParameterError
+        Naming the sweep, the parameter and both values.
+    """
+    for name, sweeps in (config.get("solvers") or {}).items():
+        for i, sweep in enumerate(sweeps):
+            where = _where("solvers", name, f"[{i}]")
+            params, grid = sweep.get("params") or {}, sweep.get("grid") or {}
+            both = sorted(set(params) & set(grid))
+            if both:
+                raise ParameterError(f"config {where}: parameter '{both[0]}' is in both params "
+                                     f"({params[both[0]]!r}) and grid ({grid[both[0]]!r}); expected it in one of them")
+            for key, values in grid.items():
+                for j, value in enumerate(values):
+                    if value in values[:j]:
+                        raise ParameterError(f"config {where}.grid.{key}: value {value!r} is listed twice; "
+                                             "expected each value once")
 
 
 def _mesh_for(params):
@@ -289,7 +307,6 @@ class Study:
                                      f"{', '.join(unknown)} that solver '{name}' declares (it makes: mesh)")
             for i, sweep in enumerate(sweeps):
                 grid = sweep.get("grid") or {}
-                _check_sweep(sweep.get("params") or {}, grid, _where("solvers", name, f"[{i}]"))
                 keys = list(grid)
                 for combination in itertools.product(*(grid[k] for k in keys)):
                     values = {**(sweep.get("params") or {}), **dict(zip(keys, combination))}

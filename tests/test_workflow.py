@@ -22,7 +22,7 @@ from conftest import copy_workflow, python_path
 from stickslip import registry
 from stickslip.params import ParameterError, parse_params
 from stickslip.provenance.record import REQUIRED_FIELDS, read_record
-from stickslip.study import Study
+from stickslip.study import Study, check_sweeps
 
 TOY_CONFIG = {
     "threads": 1,
@@ -72,11 +72,6 @@ def test_study_expands_grids_and_resolves_inputs(toy_plugins):
      r"config solvers.toy-spring-block\[0\]: parameter 'seed': expected an integer, got 'x'"),
     (lambda c: c["solvers"]["toy-spring-block"][1]["params"].update(F_d=0.95),
      r"config solvers.toy-spring-block\[1\]: parameter 'F_d': must be below"),
-    (lambda c: c["solvers"]["toy-spring-block"][0]["params"].update(seed=4),
-     r"config solvers.toy-spring-block\[0\]: parameter 'seed' is in both params \(4\) and grid \(\[1, 2, 3\]\); "
-     r"expected it in one of them"),
-    (lambda c: c["solvers"]["toy-spring-block"][0]["grid"].update(seed=[1, 2, 1]),
-     r"config solvers.toy-spring-block\[0\].grid.seed: value 1 is listed twice; expected each value once"),
     (lambda c: c["solvers"].update(nope=[]), r"config solvers.nope: unknown solver 'nope'"),
     (lambda c: c["figures"].update({"toy-force": {"height": 1}}), r"config figures.toy-force: unknown parameter"),
     (lambda c: c["solvers"].pop("toy-spring-block"), r"config analyses.toy-slips: it reads outputs"),
@@ -86,6 +81,21 @@ def test_study_errors_name_the_config_key(toy_plugins, change, message):
     change(config)
     with pytest.raises(ParameterError, match=message):
         Study(config)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda c: c["solvers"]["toy-spring-block"][0]["params"].update(seed=4),
+     r"config solvers.toy-spring-block\[0\]: parameter 'seed' is in both params \(4\) and grid \(\[1, 2, 3\]\); "
+     r"expected it in one of them"),
+    (lambda c: c["solvers"]["toy-spring-block"][0]["grid"].update(seed=[1, 2, 1]),
+     r"config solvers.toy-spring-block\[0\].grid.seed: value 1 is listed twice; expected each value once"),
+])
+def test_a_sweep_names_each_parameter_and_value_once(change, message):
+    config = copy.deepcopy(TOY_CONFIG)
+    check_sweeps(config)
+    change(config)
+    with pytest.raises(ParameterError, match=message):
+        check_sweeps(config)
 
 
 # Snakemake in a subprocess ------------------------------------------------------------------------

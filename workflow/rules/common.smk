@@ -11,12 +11,13 @@ from snakemake.exceptions import WorkflowError
 from stickslip.params import ParameterError
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
-from stickslip.study import Study, normalise, plugin_sections
+from stickslip.study import Study, check_sweeps, normalise, plugin_sections
 
 
 def _validate_plugin_sections(config):
     """Validate every plugin section against its plugin's schema, naming the key on failure."""
     normalise(config)
+    check_sweeps(config)  # before the validator fills the defaults into the sweeps' params
     with tempfile.TemporaryDirectory() as folder:
         for index, (key, section, schema) in enumerate(plugin_sections(config)):
             # one file per section: Snakemake caches a schema file's contents by path
@@ -50,3 +51,4 @@ wildcard_constraints:
 def record_of(pattern):
     """The provenance record beside an output pattern."""
     return record_path(pattern).as_posix()
+
