@@ -54,7 +54,7 @@ def _affine_response(system):
     u[system.mesh.dofs[:, 0]] = 2.0 * eps0 * system.mesh.coor[:, 1]
     system.restore(u, 2.0 * eps0 * system.heights, 0.0, 0.0)
     eps = system.state.eps.copy()
-    scale = autoscale(system.model.epsy, eps)
+    scale = autoscale(system.narrowest_well, eps)
     system.set_linear_response(scale * u, scale * eps, scale * 2.0 * eps0 * system.heights, 0.0)
     system.restore(np.zeros(system.model.ndof), np.zeros(system.mesh.nlayer), 0.0, 0.0)
 

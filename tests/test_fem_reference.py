@@ -14,7 +14,8 @@ from stickslip.fem.output import read_increments, read_run_attrs, rerun_with_fai
 from stickslip.params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
-REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "drive": "fixed-lever", "nchunk": 200}
+REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "drive": "fixed-lever", "nchunk": 200,
+                  "yield_strains": "stop"}
 
 pytestmark = pytest.mark.slow
 

@@ -122,13 +122,13 @@ def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_el
 
 
 @njit
-def autoscale(epsy, deps):
-    """Scale factor of the linear response: ``0.1 * min well width / max eps_eq(deps)``.
+def autoscale(width, deps):
+    """Scale factor of the linear response: ``0.1 * width / max eps_eq(deps)``.
 
     Parameters
     ----------
-    epsy : numpy.ndarray
-        [ni, ny] yield strains.
+    width : float
+        Width of the narrowest well [strain] (:func:`.yield_strains.narrowest_well`).
     deps : numpy.ndarray
         [ni, 4, 3] interface strain of the unscaled response.
 
@@ -136,10 +136,6 @@ def autoscale(epsy, deps):
     -------
     float
     """
-    width = np.inf
-    for e in range(epsy.shape[0]):
-        for j in range(epsy.shape[1] - 1):
-            width = min(width, epsy[e, j + 1] - epsy[e, j])
     largest = 0.0
     for e in range(deps.shape[0]):
         for q in range(4):

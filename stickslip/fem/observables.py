@@ -98,8 +98,8 @@ class Observer:
         self.top_height = heights[-1]
 
     def well_index(self):
-        """Well index of Gauss point 0 of every interface block, int64 [n_interfaces, N]."""
-        return self.system.state.idx[:, 0].reshape(self.n_interfaces, self.N).copy()
+        """Global well index of Gauss point 0 of every interface block, int64 [n_interfaces, N]."""
+        return self.system.well_index()[:, 0].reshape(self.n_interfaces, self.N)
 
     def observe(self, previous_index):
         """Observables of the current state.

@@ -243,14 +243,9 @@ def rerun_with_failures(path, increment):
     system.restore(*before)
     t0 = before[3]
     N = run.mesh.N
-    index0 = system.state.idx[:, 0].copy()
-    system.event_step(True, yield_element=yield_element)
-    kicked = system.state.idx[:, 0] - index0
-    rows = [(e, t0, np.sign(kicked[e])) for e in np.flatnonzero(kicked) for _ in range(abs(int(kicked[e])))]
-    niter, events = system.minimise(margin=run.params.margin, record=True)
+    niter, events = system.kick_and_minimise(yield_element, run.params.margin, record=True)
     if niter == 0 or not np.array_equal(system.state.u, after[0]) or system.state.t[0] != after[3]:
         raise AssertionError(f"{path}: rerunning increment {increment} did not reproduce the stored state")
-    events = np.concatenate([np.asarray(rows, dtype=np.float64).reshape(-1, 3), events])
     element = events[:, 0].astype(np.int64)
     return pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - t0,
                          "direction": events[:, 2].astype(np.int64)})

@@ -9,7 +9,7 @@ import dataclasses
 
 from ..params import ParameterError, param
 
-__all__ = ["FemParams", "DRIVES", "RELAXATIONS"]
+__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS"]
 
 #: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
 DRIVES = ("fixed-lever", "free-lever")
@@ -17,6 +17,10 @@ DRIVES = ("fixed-lever", "free-lever")
 #: How a minimisation ends: by damped dynamics only (the paper's protocol), or by an exact solve
 #: within the current wells once no well has changed for ``quiet_steps`` (docs/fem.md).
 RELAXATIONS = ("dynamic", "exact")
+
+#: What happens when a block nears the end of the yield strains held in memory: they are drawn further
+#: (the run goes on), or the run stops (the paper's code).
+SEQUENCE_ENDS = ("extend", "stop")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -30,8 +34,15 @@ class FemParams:
     k_drive: float = param(1e-3, "drive spring stiffness per unit volume (1e-3 stiff, 1e-6 compliant)",
                            unit="G/h^2", exclusive_minimum=0.0)
     drive: str = param("fixed-lever", "drive configuration", choices=DRIVES)
-    nchunk: int = param(6000, "random yield strains per block (the run stops `margin` wells before the end)",
-                        minimum=10)
+    nchunk: int = param(6000, "random yield strains per block of the paper's code: the linear response is scaled "
+                              "to the narrowest of these wells; with yield_strains = 'stop' they are all a block "
+                              "has", minimum=10)
+    yield_strains: str = param("extend", "'extend': a block's yield-strain sequence is unbounded (held `window` "
+                                         "wells at a time, drawn further from its own generator as it advances); "
+                                         "'stop': `nchunk` wells, the run stops `margin` wells before their end "
+                                         "(the paper's code)", choices=SEQUENCE_ENDS)
+    window: int = param(1000, "yield_strains 'extend': wells per block held in memory (widened when one event "
+                              "needs more); the results do not depend on it", minimum=20)
     G: float = param(1.0, "shear modulus G = 2 mu (plates and interfaces)", unit="stress", exclusive_minimum=0.0)
     K: float = param(4.5, "bulk-like modulus K (energy K eps_m^2, eps_m = tr(eps)/2)", unit="stress",
                      exclusive_minimum=0.0)
@@ -51,8 +62,8 @@ class FemParams:
                             choices=RELAXATIONS)
     quiet_steps: int = param(200, "relaxation 'exact': time steps without any well change before an equilibrium "
                                   "solve is tried (and between tries)", minimum=1)
-    margin: int = param(5, "stop when a block comes within this many wells of the end of its sequence",
-                        minimum=1)
+    margin: int = param(5, "a block within this many wells of the end of its held sequence stops the run "
+                           "('stop') or makes the event be redone with more wells held ('extend')", minimum=1)
     lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",
                                 unit="H_1 - H_0 (mid-height distance of layers 1 and 0)", exclusive_minimum=0.0)
     max_increments: int = param(0, "stop after this many increments (0: run until the margin stop)", minimum=0)

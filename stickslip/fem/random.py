@@ -20,7 +20,7 @@ import numpy as np
 
 from ..numba_options import njit
 
-__all__ = ["pcg32_uint32", "pcg32_uniform", "weibull_rows"]
+__all__ = ["pcg32_seed", "pcg32_next", "pcg32_uint32", "pcg32_uniform", "weibull_rows"]
 
 _MULTIPLIER = np.uint64(6364136223846793005)
 _ONE = np.uint64(1)
@@ -45,6 +45,34 @@ def _seed(initstate, initseq):
     state = state + np.uint64(initstate)
     state, _ = _step(state, inc)
     return state, inc
+
+
+@njit
+def pcg32_seed(initstate, initseq):
+    """Seeded generators, one per row, ready to draw.
+
+    Parameters
+    ----------
+    initstate, initseq : numpy.ndarray
+        uint64 [nrow]: seeds of each generator.
+
+    Returns
+    -------
+    state, inc : numpy.ndarray
+        uint64 [nrow]: the generators' 64-bit states and increments (``pcg32_next`` advances ``state``).
+    """
+    state = np.empty(initstate.size, dtype=np.uint64)
+    inc = np.empty(initstate.size, dtype=np.uint64)
+    for i in range(initstate.size):
+        state[i], inc[i] = _seed(initstate[i], initseq[i])
+    return state, inc
+
+
+@njit
+def pcg32_next(state, inc, row):
+    """Next 32-bit output (as uint64) of generator ``row``; advances ``state[row]`` in place."""
+    state[row], out = _step(state[row], inc[row])
+    return out
 
 
 @njit

@@ -130,7 +130,7 @@ def run_simulation(params, output, mesh, threads=1):
                     break
             else:
                 system.event_step(False)
-                if not within_margin(system.model, system.state.idx, params.margin):
+                if not system.extend and not within_margin(system.model, system.state.idx, params.margin):
                     reason = "margin"
                     break
             append_increment(file, system, _row(observer, increment, kick, yield_element, previous_index))

@@ -15,9 +15,14 @@ from .event_driven import autoscale, step_size
 from .forces import compute_force
 from .minimise import CONVERGED, MARGIN, MAX_ITER_REACHED, QUIET, minimise
 from .model import build_model, new_state
-from .yield_strains import interface_initstate, yield_strains
+from .yield_strains import HeldYieldStrains, interface_initstate, narrowest_well
 
 __all__ = ["System", "SolverError", "derived_constants"]
+
+
+def _equivalent(eps):
+    """Equivalent deviatoric strain of strains [..., 3] (xx, yy, xy)."""
+    return np.hypot(0.5 * (eps[..., 0] - eps[..., 1]), eps[..., 2])
 
 
 class SolverError(RuntimeError):
@@ -81,8 +86,14 @@ class System:
         self.mesh = mesh
         self.constants = derived_constants(params, mesh)
         initstate = interface_initstate(params.seed, mesh.N, mesh.n_interfaces)
-        epsy = yield_strains(initstate, params.nchunk, params.eps0, params.eps_offset, params.weibull_k)
-        if np.min(np.diff(epsy, axis=1)) <= self.constants["deps"]:
+        self.extend = params.yield_strains == "extend"
+        self.wells = HeldYieldStrains(initstate, params.window if self.extend else params.nchunk, params.eps0,
+                                      params.eps_offset, params.weibull_k)
+        self.narrowest_well = narrowest_well(initstate, params.nchunk, params.eps0, params.eps_offset,
+                                             params.weibull_k)
+        epsy = self.wells.epsy
+        narrowest = min(np.min(np.diff(epsy, axis=1)), params.eps_offset if self.extend else np.inf)
+        if narrowest <= self.constants["deps"]:
             raise SolverError("a well is narrower than the kick 'deps'; use a smaller 'deps' or larger 'eps_offset'")
         plastic = np.asarray(mesh.layer_is_plastic, dtype=bool)
         self.drive_active = ~plastic & (np.arange(mesh.nlayer) > 0)
@@ -126,6 +137,48 @@ class System:
         s.lever[0] = lever_target
         s.t[0] = t
         self.refresh()
+        if self.extend:
+            self.hold_wells_ahead()
+
+    def well_index(self):
+        """Global well index of every interface Gauss point (counted from the start of the sequence), int64 [ni, 4]."""
+        return self.state.idx + self.wells.offset[:, None]
+
+    def _set_epsy(self):
+        self.model = self.model._replace(epsy=self.wells.epsy)
+
+    def hold_wells_ahead(self):
+        """``yield_strains = extend``: hold at least half a window of wells ahead of every Gauss point.
+
+        A block with fewer than ``(ny - 1) // 2`` held wells ahead of its furthest Gauss
+        point has its window moved forward to start ``(ny - 1) // 4`` wells behind its
+        nearest one (or widened if its points are spread too far for that). A state
+        beyond the held wells (after :meth:`restore`) is followed to its wells; a state
+        behind them restarts the windows from the origin. The values held never change
+        the physics: they are the same numbers wherever the window is.
+        """
+        wells = self.wells
+        if np.any((wells.offset > 0) & (self.state.idx.min(axis=1) == 0)
+                  & (_equivalent(self.state.eps).min(axis=1) <= wells.epsy[:, 0])):
+            wells.start(wells.epsy.shape[1] - 1)
+            self._set_epsy()
+            self.refresh()
+        while True:
+            ny = wells.epsy.shape[1]
+            ahead, behind = (ny - 1) // 2, (ny - 1) // 4
+            idx = self.state.idx
+            short = idx.max(axis=1) > ny - 1 - ahead
+            if not short.any():
+                return
+            beyond = _equivalent(self.state.eps).max(axis=1) > wells.epsy[:, -1]
+            shift = np.where(short, np.where(beyond, ny - 1 - behind, idx.min(axis=1) - behind), 0)
+            if np.any(short & (shift <= 0)):
+                wells.widen(ny - 1)
+                self._set_epsy()
+                continue
+            wells.slide(idx, shift)
+            if beyond.any():
+                self.refresh()
 
     def snapshot(self):
         """Copies of what :meth:`restore` needs: (u, target, lever_target, t)."""
@@ -237,7 +290,7 @@ class System:
         finally:
             self.model = model
             self.state = saved
-        scale = autoscale(self.model.epsy, eps)
+        scale = autoscale(self.narrowest_well, eps)
         lever = scale * self.params.eps0 if self.model.free_lever else 0.0
         self.set_linear_response(scale * u, scale * eps, scale * unit_target, lever)
 
@@ -285,13 +338,55 @@ class System:
                               f"{'did not change' if kick else 'changed'}")
         return step
 
+    def kick_and_minimise(self, yield_element, margin, record=False):
+        """Kick (:meth:`event_step`) and :meth:`minimise`; with ``extend``, redone until the held wells suffice.
+
+        With ``yield_strains = extend``, a minimisation that comes within ``margin``
+        wells of the end of the held wells is discarded: the state before the kick is
+        restored, the windows are widened (doubled) and the kick redone, which gives
+        the state a longer sequence held from the start would give.
+
+        Parameters
+        ----------
+        yield_element : bool
+            Kick until all Gauss points of one element change well.
+        margin : int
+            See :meth:`minimise`.
+        record : bool, optional
+            Record the well changes of Gauss point 0, the kick's own included (at the
+            time of the kick).
+
+        Returns
+        -------
+        niter : int
+            Time steps made (0: stopped by the margin, ``stop`` only).
+        events : numpy.ndarray
+            [nevent, 3] (element, time, direction) when ``record``.
+        """
+        before = self.snapshot()
+        while True:
+            index = self.state.idx[:, 0].copy()
+            self.event_step(True, yield_element=yield_element)
+            kicked = self.state.idx[:, 0] - index
+            niter, events = self.minimise(margin=margin, record=record)
+            if niter or not self.extend:
+                break
+            self.restore(*before)
+            self.wells.widen(self.wells.epsy.shape[1] - 1)
+            self._set_epsy()
+        if record:
+            rows = [(e, before[3], np.sign(kicked[e])) for e in np.flatnonzero(kicked) for _ in range(abs(kicked[e]))]
+            events = np.concatenate([np.asarray(rows, dtype=np.float64).reshape(-1, 3), events])
+        return niter, events
+
     def kick(self, margin):
         """Kick and minimise (an even increment of the protocol), with the whole-element fallback.
 
-        :meth:`event_step` (kick) then :meth:`minimise`; if the minimisation ends with no
-        well index changed (the kicked point fell back), the state before the kick is
-        restored and the kick redone so that all Gauss points of one element yield
-        (``yield_element``).
+        :meth:`kick_and_minimise`; if the minimisation ends with no well index changed
+        (the kicked point fell back), the state before the kick is restored and the kick
+        redone so that all Gauss points of one element yield (``yield_element``). With
+        ``yield_strains = extend``, the held wells are then moved ahead
+        (:meth:`hold_wells_ahead`).
 
         Parameters
         ----------
@@ -301,19 +396,17 @@ class System:
         Returns
         -------
         converged : bool
-            False if stopped by the margin.
+            False if stopped by the margin (``yield_strains = stop`` only).
         yield_element : bool
             Whether the whole-element kick was needed.
         """
         before = self.snapshot()
-        index = self.state.idx.copy()
-        self.event_step(True)
-        niter, _ = self.minimise(margin=margin)
-        if niter == 0:
-            return False, False
-        if np.array_equal(self.state.idx, index):
+        index = self.well_index()
+        niter, _ = self.kick_and_minimise(False, margin)
+        fallback = niter != 0 and np.array_equal(self.well_index(), index)
+        if fallback:
             self.restore(*before)
-            self.event_step(True, yield_element=True)
-            niter, _ = self.minimise(margin=margin)
-            return niter != 0, True
-        return True, False
+            niter, _ = self.kick_and_minimise(True, margin)
+        if niter != 0 and self.extend:
+            self.hold_wells_ahead()
+        return niter != 0, fallback
