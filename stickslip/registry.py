@@ -57,7 +57,7 @@ ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.anal
 BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis",
                    "stickslip.figures.mesh", "stickslip.solvers.lever", "stickslip.figures.fig2",
                    "stickslip.figures.figs_dgamma", "stickslip.figures.figs_sequences",
-                   "stickslip.figures.figs_event_maps", "stickslip.figures.figs_tau",
+                   "stickslip.figures.figs_phi_sweep", "stickslip.figures.figs_event_maps", "stickslip.figures.figs_tau",
                    "stickslip.figures.fig3", "stickslip.figures.fig4", "stickslip.figures.fig5",
                    "stickslip.figures.fig6", "stickslip.figures.figs_individual",
                    "stickslip.figures.figs_slip_distributions", "stickslip.figures.figs_aging_variations",

@@ -118,14 +118,14 @@ def test_queries_are_read_only_and_filter(toy_results):
 def test_simulation_columns_fall_back_to_file_attributes(tmp_path):
     sim = tmp_path / "0123456789abcdef.h5"
     with open_file(sim, "w") as handle:
-        handle.attrs.update({"n_interfaces": 3, "regime": "compliant", "k_drive": 1e-6})
+        handle.attrs.update({"n_interfaces": 3, "regime": "compliant", "k_drive": 1e-6, "phi": 3.4e-11})
     record = {"run_id": "0123456789abcdef", "plugin": "fem", "params": {"plates": 4, "N": 9, "seed": 2,
                                                                         "k_drive": 1e-6},
               "outputs": [{"path": "results/default/sim/fem/0123456789abcdef.h5"}]}
     row = ingest_module._simulation_row(record, tmp_path / "0123456789abcdef.provenance.json")
     assert row == {"run_id": "0123456789abcdef", "solver": "fem", "path": "results/default/sim/fem/0123456789abcdef.h5",
                    "source": "numerical", "protocol": None, "n": 3, "a": None, "plates": 4, "blocks": 9,
-                   "k_drive": 1e-6, "regime": "compliant", "seed": 2}
+                   "k_drive": 1e-6, "phi": 3.4e-11, "regime": "compliant", "seed": 2}
 
 
 def test_regime_stated_by_an_analysis_fills_its_simulation(toy_results):

@@ -71,7 +71,8 @@ def study(tmp_path_factory):
     return {"analysis:numerical-events": event_files, "analysis:front-dynamics": front_files}
 
 
-@pytest.mark.parametrize("name", ["fig2", "figS-dgamma", "figS-sequences", "figS-event-maps", "figS-tau"])
+@pytest.mark.parametrize("name", ["fig2", "figS-dgamma", "figS-sequences", "figS-event-maps", "figS-tau",
+                                  "figS-phi-sweep"])
 def test_figure_writes_pdf_and_png(study, tmp_path, name):
     figure = registry.get("figure", name)
     inputs = {category: study[category] for category in figure.inputs}
@@ -100,3 +101,18 @@ def test_sequence_fractions_plotted_are_the_pooled_ones(study):
     np.testing.assert_allclose(any_, 1.0)
     n, single, any_ = figs_sequences.fractions_by_n(group_runs(files), "stiff")
     assert single[0] == 1.0 and (single[1:] < 1.0).all() and (any_ >= single).all()
+
+
+def test_paper_figures_leave_out_runs_away_from_the_paper_phi(study, tmp_path):
+    from stickslip.figures.numerical_common import read_inputs
+
+    attrs = {"N": N, "plates": 3, "k_drive": K_DRIVE["stiff"] / 30, "seed": 0, "c_s": C_S, "h": H_BLOCK}
+    tables = plugin.event_tables(history(N, random_events(2, "stiff", np.random.default_rng(1)), load_gamma=0.7), N)
+    sweep = tmp_path / "sweep.h5"
+    plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), sweep)
+    inputs = {"analysis:numerical-events": [*study["analysis:numerical-events"], sweep]}
+    paper = read_inputs(inputs, "analysis:numerical-events", ("slips",), "fig2")
+    assert len(paper) == 6 and str(sweep) not in {item.path for item in paper}
+    assert len(read_inputs(inputs, "analysis:numerical-events", ("slips",), "x", paper_phi=False)) == 7
+    with pytest.raises(FileFormatError, match="paper's Phi"):
+        read_inputs({"analysis:numerical-events": [sweep]}, "analysis:numerical-events", ("slips",), "fig2")

@@ -18,7 +18,7 @@ from ..h5io import FileFormatError
 FORMATS = ("table", "csv", "json")
 
 #: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
-RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "blocks", "regime",
+RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "blocks", "phi", "regime",
                "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
 
 EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",

@@ -24,12 +24,12 @@ import re
 import numpy as np
 import pandas as pd
 
+from ..fem.stiffness import PAPER_N, stiffness_ratio
+from ..fem.stiffness import driving_regime as regime_of
 from ..h5io import FileFormatError
 
 __all__ = [
-    "STIFF_THRESHOLD",
     "PAPER_N",
-    "paper_equivalent_stiffness",
     "driving_regime",
     "interfaces_in",
     "steady_state",
@@ -41,13 +41,6 @@ __all__ = [
     "sequence_fractions",
 ]
 
-#: Blocks per interface of the paper's simulations (2 x 3^6); plates are about N/3 blocks thick.
-PAPER_N = 1458
-
-#: Paper-equivalent drive stiffness (per unit volume, FE units) separating "stiff" from
-#: "compliant" driving; the paper uses 1e-3 (stiff) and 1e-6 (compliant) at N = 1458.
-STIFF_THRESHOLD = 1e-4
-
 #: Steady state: the secant modulus of the stress-strain curve has dropped below this
 #: fraction of the elastic one (reference code).
 TANGENT_FRACTION = 0.95
@@ -55,36 +48,8 @@ TANGENT_FRACTION = 0.95
 _S_COLUMN = re.compile(r"^S_a(\d+)$")
 
 
-def paper_equivalent_stiffness(k_drive, N):
-    """The drive stiffness that gives the same driving regime in the paper's system size.
-
-    The regime is set by the ratio of the drive springs to the shear stiffness of the
-    plates, Phi ~ k_drive h_p^2 / G per unit interface length, with h_p the plate thickness
-    (a drive spring of stiffness k_drive per unit volume acts on a plate of area L h_p; the
-    plate and interface layer resist a relative displacement with G L / h_p). The mesh makes
-    h_p proportional to N (about N/3 blocks), so at N blocks per interface ``k_drive`` acts as
-    ``k_drive (N / 1458)^2`` would in the paper's N = 1458.
-
-    Parameters
-    ----------
-    k_drive : float
-        Drive stiffness per unit volume [G / h^2, FE units].
-    N : int
-        Blocks per interface.
-
-    Returns
-    -------
-    float
-        ``k_drive * (N / 1458)**2`` [FE units].
-    """
-    return float(k_drive) * (float(N) / PAPER_N) ** 2
-
-
-def driving_regime(k_drive, N=PAPER_N):
-    """Return ``"stiff"`` or ``"compliant"`` driving.
-
-    Stiff if the paper-equivalent stiffness (:func:`paper_equivalent_stiffness`) is at least
-    1e-4, i.e. ``k_drive >= 1e-4`` at the paper's N = 1458 (it uses 1e-3 and 1e-6).
+def driving_regime(k_drive, N=PAPER_N, G=1.0):
+    """``"stiff"`` or ``"compliant"`` driving, from the rigidity ratio Phi of the run.
 
     Parameters
     ----------
@@ -92,12 +57,16 @@ def driving_regime(k_drive, N=PAPER_N):
         Drive spring stiffness per unit volume [FE units].
     N : int, optional
         Blocks per interface (default: the paper's 1458).
+    G : float, optional
+        The solver's modulus ``G = 2 mu``.
 
     Returns
     -------
     str
+        :func:`stickslip.fem.stiffness.driving_regime` of
+        :func:`stickslip.fem.stiffness.stiffness_ratio`.
     """
-    return "stiff" if paper_equivalent_stiffness(k_drive, N) >= STIFF_THRESHOLD else "compliant"
+    return regime_of(stiffness_ratio(k_drive, N, G))
 
 
 def interfaces_in(increments):

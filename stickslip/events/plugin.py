@@ -12,15 +12,16 @@ Output file (HDF5, tables as in :func:`stickslip.h5io.write_table`):
     runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`).
 
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
-plus ``k_equivalent`` (the paper-equivalent drive stiffness,
-:func:`~stickslip.events.extraction.paper_equivalent_stiffness`), ``regime`` ("stiff" or
-"compliant", from ``k_equivalent``), ``steady_state`` (first steady-state increment,
+plus ``phi`` (the rigidity ratio Phi, :func:`~stickslip.fem.stiffness.stiffness_ratio`),
+``regime`` ("stiff" or "compliant", from ``phi``), ``steady_state`` (first steady-state increment,
 -1 if not reached), ``analysis`` and ``analysis_version``.
 """
 
 import dataclasses
+import json
 
 from .. import h5io
+from ..fem.stiffness import driving_regime, stiffness_ratio
 from ..h5io import FileFormatError
 from ..registry import register
 from . import extraction
@@ -84,8 +85,10 @@ def event_attrs(run_attrs, classified, *, source="run"):
         raise FileFormatError(f"{source}: run attributes lack {', '.join(missing)}")
     attrs = dict(run_attrs)
     attrs["n_interfaces"] = int(run_attrs["plates"]) - 1
-    attrs["k_equivalent"] = extraction.paper_equivalent_stiffness(run_attrs["k_drive"], run_attrs["N"])
-    attrs["regime"] = extraction.driving_regime(run_attrs["k_drive"], run_attrs["N"])
+    params = run_attrs.get("params", {})
+    G = (json.loads(params) if isinstance(params, str) else params).get("G", 1.0)
+    attrs["phi"] = stiffness_ratio(run_attrs["k_drive"], run_attrs["N"], G)
+    attrs["regime"] = driving_regime(attrs["phi"])
     steady = classified["increment"][classified["steady"]]
     attrs["steady_state"] = int(steady.iloc[0]) if steady.size else -1
     return attrs

@@ -31,6 +31,7 @@ from .. import __version__
 from ..h5io import FileFormatError, open_file, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
 from ..params import parse_params, params_to_dict
+from .stiffness import driving_regime, stiffness_ratio
 from .observables import observable_columns
 from .parameters import FemParams
 
@@ -53,12 +54,13 @@ def create_file(file, system, observer):
     """
     p = system.params
     c = system.constants
+    phi = stiffness_ratio(p.k_drive, p.N, p.G)
     write_attrs(file, {
         "solver": "fem", "version": __version__, "params": params_to_dict(p),
         "N": p.N, "plates": p.plates, "n_interfaces": p.plates - 1, "k_drive": p.k_drive, "drive": p.drive,
         "seed": p.seed, "nchunk": p.nchunk, "eps0": p.eps0, "sig0": c["sig0"], "gamma0": observer.gamma0,
         "c_s": c["c_s"], "h": c["h"], "dt": c["dt"], "alpha": c["alpha"], "H": c["H"],
-        "nstored": 0, "completed": False, "stop_reason": "",
+        "nstored": 0, "completed": False, "stop_reason": "", "phi": phi, "regime": driving_regime(phi),
     })
     save_mesh(system.mesh, file.create_group("mesh"))
     event = file.create_group("event")

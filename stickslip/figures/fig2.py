@@ -6,7 +6,8 @@ microscopic events as black dots, single-slip stress drops in the colour of the 
 interface, multi-slip drops black. (c) rho(s), the fraction of slip events involving s
 interfaces, for every n: stiff dashed, compliant solid. (f) Density of the stress drop
 Delta mu_a [sig0] of the slipping interface in single-slip events, compliant driving, every n.
-Runs are pooled by (regime, n) over seeds; the panel texts give N and the number of events.
+Runs at the paper's Phi (5e-4 stiff, 5e-7 compliant) are pooled by (regime, n) over seeds; the
+panel texts give N, Phi and the number of events.
 """
 
 import dataclasses
@@ -17,7 +18,7 @@ from ..events.extraction import interfaces_in, slip_fractions
 from ..events.results import group_runs, pooled
 from ..params import param
 from ..registry import register
-from .numerical_common import REGIME_LINESTYLE, read_inputs
+from .numerical_common import REGIME_LINESTYLE, read_inputs, run_phi
 from .plotting import label_panels, n_style, plot_density, range_edges
 from .style import interface_color, plt, save_figure
 
@@ -97,8 +98,8 @@ def _trace_panel(ax, groups, regime, n, slips_shown):
     ax.plot([], [], color="k", lw=1.8, label="multi-slip")
     ax.plot([], [], "k.", ms=3, label="microscopic")
     ax.legend(fontsize=6, loc="lower right", ncol=2, frameon=False)
-    ax.text(0.98, 0.97, f"$N = {run_file.attrs['N']}$, seed {run_file.attrs.get('seed', '?')}", transform=ax.transAxes,
-            ha="right", va="top", fontsize=7)
+    ax.text(0.98, 0.97, f"$N = {run_file.attrs['N']}$, $\\Phi = {run_phi(run_file.attrs):.1e}$, "
+            f"seed {run_file.attrs.get('seed', '?')}", transform=ax.transAxes, ha="right", va="top", fontsize=7)
 
 
 def _rho_panel(ax, groups):
@@ -133,7 +134,7 @@ def _drop_panel(ax, groups, bins):
     ax.legend(fontsize=7, frameon=False, title="(events)", title_fontsize=6)
 
 
-@register("figure", NAME, "1", Fig2Params, inputs=("analysis:numerical-events",))
+@register("figure", NAME, "2", Fig2Params, inputs=("analysis:numerical-events",))
 def run(params, inputs, output):
     """Fig. 2: Sigma(gamma) stiff and compliant, rho(s) for every n, P(Delta mu_a) compliant."""
     files = read_inputs(inputs, "analysis:numerical-events", ("increments", "slips", "slip_interfaces"), NAME)

@@ -3,18 +3,27 @@ figS-event-maps, figS-tau): reading their inputs, line styles per driving regime
 """
 
 from ..events.results import read_analysis_file
+from ..fem.stiffness import at_paper_phi, stiffness_ratio
 from ..h5io import FileFormatError
 
-__all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "read_inputs"]
+__all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "read_inputs", "run_phi"]
 
 #: The paper's convention: stiff driving dashed, compliant solid.
 REGIME_LINESTYLE = {"stiff": "--", "compliant": "-"}
 
-REGIME_LABEL = {"stiff": "stiff driving", "compliant": "compliant driving"}
+REGIME_LABEL = {"stiff": r"stiff driving, $\Phi \simeq 5 \times 10^{-4}$",
+                "compliant": r"compliant driving, $\Phi \simeq 5 \times 10^{-7}$"}
 
 
-def read_inputs(inputs, category, tables, figure):
-    """Read every analysis file of one input category.
+def run_phi(attrs):
+    """Phi of the run an analysis file comes from (its ``phi`` attribute, or from ``k_drive`` and ``N``)."""
+    if "phi" in attrs:
+        return float(attrs["phi"])
+    return stiffness_ratio(attrs["k_drive"], attrs["N"])
+
+
+def read_inputs(inputs, category, tables, figure, paper_phi=True):
+    """Read the analysis files of one input category (by default those of runs at the paper's Phi).
 
     Parameters
     ----------
@@ -26,6 +35,10 @@ def read_inputs(inputs, category, tables, figure):
         Tables to read from each file.
     figure : str
         Figure name, for error messages.
+    paper_phi : bool, optional
+        Keep only runs at the paper's Phi, 5e-4 (stiff) or 5e-7 (compliant) within a factor
+        sqrt(10) (:func:`stickslip.fem.stiffness.at_paper_phi`): the figures of the paper
+        leave out the runs of a Phi sweep.
 
     Returns
     -------
@@ -34,9 +47,15 @@ def read_inputs(inputs, category, tables, figure):
     Raises
     ------
     FileFormatError
-        If the category has no file.
+        If the category has no file (at the paper's Phi).
     """
     paths = list(inputs.get(category, []))
     if not paths:
         raise FileFormatError(f"figure '{figure}': no input file of category '{category}'")
-    return [read_analysis_file(path, tables) for path in paths]
+    files = [read_analysis_file(path, tables) for path in paths]
+    if paper_phi:
+        files = [item for item in files if at_paper_phi(run_phi(item.attrs))]
+        if not files:
+            raise FileFormatError(f"figure '{figure}': no input of category '{category}' from a run at the paper's "
+                                  f"Phi (5e-4 or 5e-7 within a factor 3.2; docs/numerical-analysis.md)")
+    return files

@@ -26,7 +26,7 @@ __all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "Artifact", "Simulatio
            "VIEWS", "engine_for", "create_schema"]
 
 #: Version of the table layout; a database of another version must be rebuilt.
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 class Base(DeclarativeBase):
@@ -97,6 +97,8 @@ class Simulation(Base):
     blocks: Mapped[int | None] = mapped_column(Integer, doc="N, blocks per interface (fem); SQLite names "
                                                            "are case-insensitive, so not 'N' beside 'n'")
     k_drive: Mapped[float | None] = mapped_column(Float, doc="drive spring stiffness (solver units)")
+    phi: Mapped[float | None] = mapped_column(Float, index=True, doc="rigidity ratio Phi = K / K_s of the drive "
+                                                                   "(fem; stickslip.fem.stiffness)")
     regime: Mapped[str | None] = mapped_column(String, index=True, doc="driving regime, e.g. stiff or compliant")
     seed: Mapped[int | None] = mapped_column(Integer)
 
@@ -144,7 +146,7 @@ Index("ix_slip_events_sim_interface", SlipEvent.simulation_run_id, SlipEvent.int
 #: Views created with the tables: name -> SELECT.
 VIEWS = {
     "slip_events_full": (
-        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.regime, s.seed "
+        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed "
         "FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
 }
 

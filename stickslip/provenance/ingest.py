@@ -45,7 +45,8 @@ EVENT_COLUMNS = {"event": "event", "a": "interface", "dR": "slip", "dmu": "dmu",
 #: Column of ``simulations`` -> names it comes from, first found: a parameter of the run, else a
 #: root attribute of the simulation file (fem runs have ``plates``; their files say ``n_interfaces``).
 SIMULATION_COLUMNS = {"protocol": ("protocol",), "n": ("n", "n_interfaces"), "a": ("a",), "plates": ("plates",),
-                      "blocks": ("N",), "k_drive": ("k_drive",), "regime": ("regime",), "seed": ("seed",)}
+                      "blocks": ("N",), "k_drive": ("k_drive",), "phi": ("phi",),
+                      "regime": ("regime",), "seed": ("seed",)}
 
 #: A simulation's driving regime, when its parameters do not state it, is the one its analysis
 #: output states (numerical-events: from k_drive); set once both records are in the same ingest.

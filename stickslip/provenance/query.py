@@ -79,7 +79,7 @@ def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=No
     -------
     pandas.DataFrame
         One row per run: the ``runs`` columns, then ``solver``, ``source``,
-        ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``regime``
+        ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``phi``, ``regime``
         (NULL for runs that are not simulations); ordered by kind, plugin, run id.
 
     Notes
@@ -87,7 +87,7 @@ def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=No
     Cost: one indexed query; linear in the number of runs returned.
     """
     columns = [Simulation.solver, Simulation.source, Simulation.protocol, Simulation.n, Simulation.a,
-               Simulation.plates, Simulation.blocks, Simulation.k_drive, Simulation.regime]
+               Simulation.plates, Simulation.blocks, Simulation.k_drive, Simulation.phi, Simulation.regime]
     statement = (select(Run, *columns).outerjoin(Simulation, Simulation.run_id == Run.run_id)
                  .order_by(Run.kind, Run.plugin, Run.run_id))
     statement = _where(statement, [(Run.kind, kind), (Run.plugin, plugin), (Simulation.solver, solver),
@@ -117,7 +117,7 @@ def events(database=DEFAULT_DATABASE, *, solver=None, analysis=None, source=None
     -------
     pandas.DataFrame
         The ``slip_events_full`` view: one row per slip of one interface in one
-        event, with ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
+        event, with ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``phi``,
         ``regime``, ``seed``; ordered by simulation, event, interface.
 
     Notes
