@@ -70,6 +70,9 @@ class FemParams:
 
     def check(self):
         """Check conditions across fields."""
+        if self.yield_strains == "extend" and self.max_increments == 0:
+            raise ParameterError("parameter 'max_increments': 0 with yield_strains = 'extend' would run forever; "
+                                 "expected max_increments > 0 (or yield_strains = 'stop')")
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
