@@ -39,7 +39,8 @@ def test_free_lever_moment_balance_holds_at_every_increment(tmp_path):
 
 @pytest.mark.parametrize("drive", ["fixed-lever", "free-lever"])
 def test_compliant_driving_runs(tmp_path, drive):
-    table, attrs = _run(tmp_path / "compliant.h5", plates=2, k_drive=1e-6, drive=drive)
+    # Phi = 3e-11: slips of thousands of wells per block; the paper code's margin stop ends the run
+    table, attrs = _run(tmp_path / "compliant.h5", plates=2, k_drive=1e-6, drive=drive, yield_strains="stop")
     assert attrs["completed"]
     assert len(table) > 5
     assert table["A_a1"].sum() > 0
