@@ -20,6 +20,7 @@ from numba import prange
 
 from ..numba_options import njit
 from .materials import cusp_stress, equivalent_strain, well_index
+from .structured import apply_stencils
 
 __all__ = ["compute_force", "compute_force_in_wells", "wells_hold", "interface_strain", "layer_ubar"]
 
@@ -113,6 +114,15 @@ def _interface_elements_parallel(nblock, iface_dofs, dNdx, iface_dV, epsy, K, G,
                             idx, eps, sig, fe, update_wells)
 
 
+@njit(parallel=True)
+def _plates_stencils_parallel(nblock, blocks, index, coef, u, f):
+    n = f.size
+    for b in prange(nblock):
+        f[b * n // nblock:(b + 1) * n // nblock] = 0.0
+    for b in prange(nblock):
+        apply_stencils(index, coef, blocks[b], blocks[b + 1], u, f)
+
+
 @njit
 def layer_ubar(model, u, out):
     """Volume-averaged x-displacement of every layer, ``out[l] = w_l . u`` [length]."""
@@ -147,12 +157,19 @@ def _drive(model, state):
 @njit
 def _force(model, state, fe, update_wells):
     m = model
-    if m.nblock > 1:
+    if m.structured and m.nblock > 1:
+        _plates_stencils_parallel(m.nblock, m.stencil_blocks, m.stencil_index, m.stencil_coef, state.u, state.f)
+    elif m.structured:
+        state.f[:] = 0.0
+        apply_stencils(m.stencil_index, m.stencil_coef, 0, m.stencil_index.shape[0], state.u, state.f)
+    elif m.nblock > 1:
         _plates_rows_parallel(m.nblock, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+    else:
+        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+    if m.nblock > 1:
         _interface_elements_parallel(m.nblock, m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G, state.u,
                                      state.idx, state.eps, state.sig, fe, update_wells)
     else:
-        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
         _interface_elements(0, m.iface_dofs.shape[0], m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G,
                             state.u, state.idx, state.eps, state.sig, fe, update_wells)
     for e in range(model.iface_dofs.shape[0]):

@@ -13,13 +13,18 @@ import numpy as np
 from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, layer_average_weights,
                        lumped_diagonal)
 from .quad4 import element_coordinates, shape_gradients
+from .structured import build_stencils, line_blocks
 
-__all__ = ["Model", "State", "build_model", "new_state"]
+__all__ = ["Model", "State", "PLATE_KERNELS", "build_model", "new_state"]
 
 Model = namedtuple("Model", [
     "ndof",           # int: number of DOFs
     "dt",             # float: time step [time]
     "k_ptr", "k_col", "k_val",  # CSR [ndof, ndof] elastic stiffness of the plates [stress] (k_col int32)
+    "structured",     # bool: plates by the stencils below (else by the CSR product, the reference)
+    "stencil_index",  # int64 [nentry, 8]: stencil entries of the plates (:mod:`.structured`)
+    "stencil_coef",   # float64 [nentry, 4]
+    "stencil_blocks", # int64 [nblock + 1]: entry ranges of the parallel blocks (whole node lines)
     "mass_inv",       # float64 [ndof]: 1 / lumped mass on free DOFs, 0 on prescribed DOFs
     "damping",        # float64 [ndof]: lumped background damping [mass / time]
     "prescribed",     # bool [ndof]
@@ -52,8 +57,12 @@ State = namedtuple("State", [
 ])
 
 
+#: Plate kernels: periodic stencils over node lines (default), or the assembled CSR product (reference).
+PLATE_KERNELS = ("structured", "assembled")
+
+
 def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height,
-                threads=1):
+                threads=1, plate_kernel="structured"):
     """Assemble the model arrays of a layered mesh.
 
     Parameters
@@ -79,6 +88,9 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     threads : int, optional
         Number of threads of the parallel kernels (1: serial kernels). The results do
         not depend on it.
+    plate_kernel : str, optional
+        One of :data:`PLATE_KERNELS`: the plates' product by stencils (:mod:`.structured`,
+        equal to the assembled product up to round-off) or by the assembled CSR matrix.
 
     Returns
     -------
@@ -100,6 +112,10 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     k_ptr, k_col, k_val = assemble_csr(edofs[elastic], elastic_element_stiffness(dNdx[elastic], dV[elastic], K, G),
                                        ndof)
     k_col = k_col.astype(np.int32)  # less memory traffic in the sparse product
+    if plate_kernel not in PLATE_KERNELS:
+        raise ValueError(f"plate_kernel {plate_kernel!r}: expected one of {PLATE_KERNELS}")
+    stencils = build_stencils(mesh, k_ptr, k_col, k_val)
+    nblock = 4 * int(threads) if threads > 1 else 1
     nelem = conn.shape[0]
     mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
     damping = lumped_diagonal(xe, edofs, np.full(nelem, alpha), ndof)
@@ -117,13 +133,15 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
         ptr.append(ptr[-1] + d.size)
     heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
     return Model(
-        ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, mass_inv=mass_inv, damping=damping,
+        ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, structured=plate_kernel == "structured",
+        stencil_index=stencils.index, stencil_coef=stencils.coef, stencil_blocks=line_blocks(stencils.index, nblock),
+        mass_inv=mass_inv, damping=damping,
         prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
         iface_dV=dV[iface], epsy=np.ascontiguousarray(epsy, dtype=np.float64), K=float(K), G=float(G),
         layer_ptr=np.asarray(ptr, dtype=np.int64), layer_xdofs=np.concatenate(xdofs),
         layer_w=np.concatenate(weights), layer_volume=np.asarray(volume),
         drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),
-        lever_ratio=heights / float(lever_height), nblock=4 * int(threads) if threads > 1 else 1)
+        lever_ratio=heights / float(lever_height), nblock=nblock)
 
 
 def new_state(model):

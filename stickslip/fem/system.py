@@ -68,6 +68,9 @@ class System:
     mesh : stickslip.mesh.LayeredMesh
     threads : int, optional
         Threads of the parallel kernels (1: serial kernels); results do not depend on it.
+    plate_kernel : str, optional
+        ``"structured"`` (stencils, default) or ``"assembled"`` (the CSR product, the
+        reference): see :func:`.model.build_model`.
 
     Attributes
     ----------
@@ -81,7 +84,7 @@ class System:
         [ni, 4, 3], layer targets [nlayer], lever drive target (free lever).
     """
 
-    def __init__(self, params, mesh, threads=1):
+    def __init__(self, params, mesh, threads=1, plate_kernel="structured"):
         self.params = params
         self.mesh = mesh
         self.constants = derived_constants(params, mesh)
@@ -101,7 +104,8 @@ class System:
         c = self.constants
         self.model = build_model(mesh, epsy=epsy, K=params.K, G=params.G, rho=params.rho, alpha=c["alpha"],
                                  dt=c["dt"], k_drive=params.k_drive, drive_active=self.drive_active,
-                                 free_lever=params.drive == "free-lever", lever_height=c["H"], threads=threads)
+                                 free_lever=params.drive == "free-lever", lever_height=c["H"], threads=threads,
+                                 plate_kernel=plate_kernel)
         self.state = new_state(self.model)
         self._fe = np.zeros((self.model.iface_dofs.shape[0], 8))
         self.delta_u = self.delta_eps = self.delta_target = None
