@@ -5,12 +5,16 @@ Usage::
     python benchmarks/fem_relaxation_fidelity.py reference [--tol 1e-5]
     python benchmarks/fem_relaxation_fidelity.py statistics --N 54 --plates 3 --k_drive 0.729 \\
         --increments 4000 --dir runs/
+    python benchmarks/fem_relaxation_fidelity.py time-step --N 54 --plates 3 --k_drive 0.729 --dir runs/
 
 ``reference`` (check a): the N = 9 reference case (FixedLever_historic), both relaxations
 from the same linear response (the dynamic one), increment by increment: where the
 per-increment ``S_a1``, ``A_a1`` first differ, the largest relative difference of the
 stress ``sigd`` after the kicks before that, and, after the first kick, how far the dynamic
 end state is from the exact equilibrium of its own wells (the dynamic tolerance's error).
+
+``time-step``: the same statistics from runs with ``dt_scale`` 1, 2 and 4 (default with
+``relaxation = exact``), each compared with ``dt_scale = 1``.
 
 ``statistics`` (check b): one run per relaxation (real run files in ``--dir``, resumed if
 present), then the steady-state slip events of each (:mod:`stickslip.events.extraction`):
@@ -100,35 +104,52 @@ def _run(params, path):
     return time.perf_counter() - start
 
 
-def statistics(args):
-    directory = Path(args.dir)
-    directory.mkdir(parents=True, exist_ok=True)
-    n = args.plates - 1
-    results = {}
-    for relaxation in ("dynamic", "exact"):
-        params = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed,
-                  "max_increments": args.increments, "relaxation": relaxation}
-        path = directory / f"N{args.N}_plates{args.plates}_k{args.k_drive:g}_seed{args.seed}_{relaxation}.h5"
-        seconds = _run(params, path)
-        table = read_increments(path)
-        classified = classify_increments(table, args.N)
-        slips = slip_events(classified, args.N)
-        drops = slip_interfaces(classified, args.N)
-        counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
-        steps = table["t"].iloc[-1] / read_run_attrs(path)["dt"] / max(int(table["kick"].iloc[1:].sum()), 1)
-        print(f"{relaxation}: {len(table)} increments ({seconds:.0f} s this call), {len(slips)} steady-state slip "
-              f"events, counts by s = {counts.tolist()}, rho(s) = {np.round(counts / max(counts.sum(), 1), 3).tolist()}, "
-              f"Delta mu_a mean {drops['dmu'].mean():.4f} std {drops['dmu'].std():.4f} (sig0), "
-              f"time steps per kick {steps:.0f}")
-        results[relaxation] = (counts, drops["dmu"].to_numpy())
-    (c1, d1), (c2, d2) = results["dynamic"], results["exact"]
+def _slip_statistics(label, params, directory):
+    """Run (or resume) one simulation; its rho(s) counts and Delta mu_a values of the steady state."""
+    name = "_".join(f"{key}{value}" for key, value in params.items() if key not in ("max_increments",))
+    path = Path(directory) / f"{name}.h5"
+    seconds = _run(params, path)
+    table = read_increments(path)
+    N, n = params["N"], params["plates"] - 1
+    classified = classify_increments(table, N)
+    slips = slip_events(classified, N)
+    drops = slip_interfaces(classified, N)["dmu"].to_numpy()
+    counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
+    steps = table["t"].iloc[-1] / read_run_attrs(path)["dt"] / max(int(table["kick"].iloc[1:].sum()), 1)
+    print(f"{label}: {len(table)} increments ({seconds:.0f} s this call), {len(slips)} steady-state slip events, "
+          f"counts by s = {counts.tolist()}, rho(s) = {np.round(counts / max(counts.sum(), 1), 3).tolist()}, "
+          f"Delta mu_a: {drops.size} values, mean {drops.mean():.4f} std {drops.std():.4f} (sig0), "
+          f"time steps per kick {steps:.0f}")
+    return counts, drops
+
+
+def _compare(first, second):
+    """Two-sample tests of rho(s) (chi-square on the counts) and P(Delta mu_a) (KS, Anderson-Darling)."""
+    (c1, d1), (c2, d2) = first, second
     used = (c1 + c2) > 0
     rho_p = stats.chi2_contingency(np.array([c1[used], c2[used]]))[1] if used.sum() > 1 else 1.0
     ks = stats.ks_2samp(d1, d2)
     ad = stats.anderson_ksamp([d1, d2], method=stats.PermutationMethod(n_resamples=2000, random_state=0))
     print(f"rho(s): chi-square p = {rho_p:.3f}; P(Delta mu_a): KS statistic {ks.statistic:.3f} p = {ks.pvalue:.3f}, "
           f"Anderson-Darling p = {ad.pvalue:.3f}")
-    print(f"slips={len(d1)},{len(d2)} rho_p={rho_p:.3f} dmu_ks_p={ks.pvalue:.3f} dmu_ad_p={ad.pvalue:.3f}")
+    return f"slips={len(d1)},{len(d2)} rho_p={rho_p:.3f} dmu_ks_p={ks.pvalue:.3f} dmu_ad_p={ad.pvalue:.3f}"
+
+
+def statistics(args):
+    base = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed,
+            "max_increments": args.increments}
+    dynamic = _slip_statistics("dynamic", {**base, "relaxation": "dynamic"}, args.dir)
+    exact = _slip_statistics("exact", {**base, "relaxation": "exact"}, args.dir)
+    print(_compare(dynamic, exact))
+
+
+def time_step(args):
+    base = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed,
+            "max_increments": args.increments, "relaxation": args.relaxation}
+    runs = {scale: _slip_statistics(f"dt_scale={scale:g}", {**base, "dt_scale": scale}, args.dir)
+            for scale in (1.0, 2.0, 4.0)}
+    for scale in (2.0, 4.0):
+        print(f"dt_scale={scale:g} against 1: {_compare(runs[1.0], runs[scale])}")
 
 
 def main(argv=None):
@@ -137,14 +158,17 @@ def main(argv=None):
     ref = sub.add_parser("reference", help="check a: the N = 9 reference case increment by increment")
     ref.add_argument("--tol", type=float, default=1e-5, help="minimisation tolerance of both relaxations")
     stat = sub.add_parser("statistics", help="check b: slip statistics of one run per relaxation")
-    stat.add_argument("--N", type=int, default=54)
-    stat.add_argument("--plates", type=int, default=3)
-    stat.add_argument("--k_drive", type=float, required=True)
-    stat.add_argument("--seed", type=int, default=0)
-    stat.add_argument("--increments", type=int, default=4000)
-    stat.add_argument("--dir", default="fidelity-runs", help="directory of the run files (resumed if present)")
+    step = sub.add_parser("time-step", help="slip statistics with dt, 2 dt and 4 dt")
+    step.add_argument("--relaxation", default="exact", choices=("dynamic", "exact"))
+    for command in (stat, step):
+        command.add_argument("--N", type=int, default=54)
+        command.add_argument("--plates", type=int, default=3)
+        command.add_argument("--k_drive", type=float, required=True)
+        command.add_argument("--seed", type=int, default=0)
+        command.add_argument("--increments", type=int, default=4000)
+        command.add_argument("--dir", default="fidelity-runs", help="directory of the run files (resumed if present)")
     args = parser.parse_args(argv)
-    (reference if args.check == "reference" else statistics)(args)
+    {"reference": reference, "statistics": statistics, "time-step": time_step}[args.check](args)
 
 
 if __name__ == "__main__":

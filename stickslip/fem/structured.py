@@ -50,7 +50,7 @@ class PlateStencils:
 
 def _node_lines(mesh):
     """Node lines: list of (start DOF, number of nodes), and per DOF its (line, node) position."""
-    grid_y = np.round(np.asarray(mesh.coor)[:, 1] / mesh.h).astype(np.int64)
+    grid_y = np.asarray(mesh.coor)[:, 1]  # a node line: nodes of bitwise equal height
     x = np.asarray(mesh.coor)[:, 0]
     dofs = np.asarray(mesh.dofs, dtype=np.int64)
     ndof = int(dofs.max()) + 1
@@ -64,7 +64,7 @@ def _node_lines(mesh):
         independent = np.unique(first)
         start, n = int(independent[0]), independent.size
         if not np.array_equal(independent, start + 2 * np.arange(n)) or np.any(dofs[nodes, 1] != first + 1):
-            raise ValueError(f"node line at y = {y} h: DOFs are not contiguous (x, y) pairs")
+            raise ValueError(f"node line at y = {y}: DOFs are not contiguous (x, y) pairs")
         line_of_dof[start:start + 2 * n] = len(lines)
         node_of_dof[start:start + 2 * n] = np.repeat(np.arange(n), 2)
         lines.append((start, n))

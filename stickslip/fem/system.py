@@ -42,7 +42,7 @@ def derived_constants(params, mesh):
     dict
         ``L`` (periodic length), ``c`` = sqrt(G / rho), ``c_s`` = sqrt(G / 2 / rho)
         (shear-wave speed), ``alpha`` = sqrt(2) (2 pi / L) c rho (critical damping of
-        the shear wave of wavelength L), ``dt`` = h / (2 pi c) / 10, ``sig0`` = 2 G eps0,
+        the shear wave of wavelength L), ``dt`` = ``dt_scale`` h / (2 pi c) / 10, ``sig0`` = 2 G eps0,
         ``deps`` (kick, strain), ``H`` (free-lever drive height).
     """
     h = float(mesh.h)
@@ -52,7 +52,7 @@ def derived_constants(params, mesh):
     return {
         "h": h, "L": L, "c": c, "c_s": math.sqrt(params.G / 2.0 / params.rho),
         "alpha": math.sqrt(2.0) * (2.0 * math.pi / L) * c * params.rho,
-        "dt": (1.0 / (c * 2.0 * math.pi / h)) / 10.0,
+        "dt": params.dt_scale * (1.0 / (c * 2.0 * math.pi / h)) / 10.0,
         "sig0": 2.0 * params.G * params.eps0,
         "deps": params.deps * params.eps0,
         "H": params.lever_height * float(heights[1] - heights[0]),
