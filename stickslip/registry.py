@@ -55,7 +55,7 @@ ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.anal
 
 #: Modules whose import registers the built-in plugins.
 BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis",
-                   "stickslip.figures.mesh", "stickslip.solvers.lever", "stickslip.figures.fig2",
+                   "stickslip.figures.mesh", "stickslip.solvers.lever", "stickslip.solvers.rate_state_lever", "stickslip.figures.fig2",
                    "stickslip.figures.figs_dgamma", "stickslip.figures.figs_sequences",
                    "stickslip.figures.figs_phi_sweep", "stickslip.figures.figs_event_maps", "stickslip.figures.figs_tau",
                    "stickslip.figures.fig3", "stickslip.figures.fig4", "stickslip.figures.fig5",

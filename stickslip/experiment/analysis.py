@@ -147,7 +147,8 @@ def _sha256(path):
     return digest.hexdigest()
 
 
-@registry.register("analysis", "experiment-events", VERSION, ExperimentEventsParams, inputs=("lever",))
+@registry.register("analysis", "experiment-events", VERSION, ExperimentEventsParams,
+                   inputs=("lever", "rate-state-lever"))
 def run(params, input, output):
     """Detect and measure every slip of one experimental time series (lab or lever run)."""
     input = Path(input)

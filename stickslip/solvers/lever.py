@@ -28,7 +28,7 @@ from ..experiment.timeseries import PROTOCOLS, write_timeseries
 from ..experiment.virtual import Apparatus, FrictionLaw, integrate, record, relative_positions
 from ..params import ParameterError, param, params_to_dict
 
-__all__ = ["LeverParams", "run", "simulate", "apparatus", "friction_law", "per_interface"]
+__all__ = ["LeverParams", "run", "simulate", "apparatus", "friction_law", "per_interface", "check_protocol"]
 
 VERSION = "1"
 
@@ -79,17 +79,7 @@ class LeverParams:
 
     def check(self):
         """Check the conditions that involve several fields."""
-        if self.protocol == "stack":
-            if self.n > self.n_slabs:
-                raise ParameterError(f"parameter 'n': expected a value <= n_slabs={self.n_slabs}, got {self.n}")
-            if self.a != 0:
-                raise ParameterError(f"parameter 'a': must be 0 for the stack protocol, got {self.a}")
-        else:
-            if not 1 <= self.a <= self.n_slabs:
-                raise ParameterError(f"parameter 'a': expected 1..n_slabs={self.n_slabs} for the individual "
-                                     f"protocol, got {self.a}")
-            if self.n != 1:
-                raise ParameterError(f"parameter 'n': must be 1 for the individual protocol, got {self.n}")
+        check_protocol(self)
         for name in PER_INTERFACE:
             if len(getattr(self, name)) not in (1, self.n_slabs):
                 raise ParameterError(f"parameter '{name}': expected 1 or n_slabs={self.n_slabs} values, "
@@ -101,6 +91,22 @@ class LeverParams:
                 f"parameter 'B': the weakest healing during a slip, strength_offset + B ln(1 + slip_duration/T0) = "
                 f"{heals:.3g}, must exceed the loading during a slip, {fastest:.3g}, or an interface slips "
                 f"again before it heals")
+
+
+def check_protocol(params):
+    """Raise ParameterError unless ``n``, ``a`` and ``n_slabs`` fit the protocol (also used by
+    :mod:`stickslip.solvers.rate_state_lever`)."""
+    if params.protocol == "stack":
+        if params.n > params.n_slabs:
+            raise ParameterError(f"parameter 'n': expected a value <= n_slabs={params.n_slabs}, got {params.n}")
+        if params.a != 0:
+            raise ParameterError(f"parameter 'a': must be 0 for the stack protocol, got {params.a}")
+    else:
+        if not 1 <= params.a <= params.n_slabs:
+            raise ParameterError(f"parameter 'a': expected 1..n_slabs={params.n_slabs} for the individual "
+                                 f"protocol, got {params.a}")
+        if params.n != 1:
+            raise ParameterError(f"parameter 'n': must be 1 for the individual protocol, got {params.n}")
 
 
 def per_interface(params, name):
@@ -170,9 +176,9 @@ def simulate(params):
     lever, law = apparatus(params), friction_law(params)
     history = integrate(lever, law, params.duration, params.slip_duration,
                         np.random.Generator(np.random.PCG64(disorder_seed)))
-    signals = record(lever, history, n=params.n, protocol=params.protocol, a=params.a,
-                     force_rate=params.force_rate, frame_rate=params.frame_rate, force_noise=params.force_noise,
-                     position_noise=params.position_noise, rng=np.random.Generator(np.random.PCG64(sensor_seed)))
+    signals = record(lever, lambda times: relative_positions(history, times), history.duration, n=params.n,
+                     protocol=params.protocol, a=params.a, force_rate=params.force_rate, frame_rate=params.frame_rate,
+                     force_noise=params.force_noise, position_noise=params.position_noise, rng=np.random.Generator(np.random.PCG64(sensor_seed)))
     return signals, history.slips, _interfaces_table(lever, law, history)
 
 

@@ -1,6 +1,7 @@
 """Sensors of the virtual experiment: the camera (slab positions) and the force sensor (lever force).
 
-The slips of a :class:`.history.SlipHistory` are turned into continuous signals: interface
+:func:`record` samples any noise-free slip history ``R(t)``. For the event-by-event lever model,
+:func:`relative_positions` turns the slips of a :class:`.history.SlipHistory` into continuous signals: interface
 ``i`` slips by ``dR`` along the smooth ramp ``dR (1 - cos(pi s)) / 2``, ``s = (t - t_start) /
 slip_duration`` in [0, 1], and creeps linearly at its creep velocity during each creep segment.
 The slab positions follow as ``x = cumsum(R)``, the lever force from the moment balance
@@ -82,13 +83,18 @@ def relative_positions(history, times):
     return R
 
 
-def record(apparatus, history, *, n, protocol, a, force_rate, frame_rate, force_noise, position_noise, rng):
+def record(apparatus, slips_at, duration, *, n, protocol, a, force_rate, frame_rate, force_noise, position_noise,
+           rng):
     """Sample the sensors and return the experiment record.
 
     Parameters
     ----------
     apparatus : Apparatus
-    history : SlipHistory
+    slips_at : callable
+        Noise-free slip of every interface at given times: ``slips_at(times [n_t]) -> R [n_t, n_slabs]``
+        [mm] (e.g. ``lambda t: relative_positions(history, t)``).
+    duration : float
+        Length of the run [s]; samples from 0 to ``duration``.
     n, a : int
         Driven slabs and the slab driven alone (0 for "stack"), as recorded.
     protocol : {"stack", "individual"}
@@ -105,10 +111,10 @@ def record(apparatus, history, *, n, protocol, a, force_rate, frame_rate, force_
     -------
     ExperimentRecord
     """
-    t_x = sample_times(history.duration, frame_rate)
-    t_F = sample_times(history.duration, force_rate)
-    x = apparatus.positions(relative_positions(history, t_x))
-    F = apparatus.lever_force(apparatus.spring_forces(t_F, apparatus.positions(relative_positions(history, t_F))))
+    t_x = sample_times(duration, frame_rate)
+    t_F = sample_times(duration, force_rate)
+    x = apparatus.positions(slips_at(t_x))
+    F = apparatus.lever_force(apparatus.spring_forces(t_F, apparatus.positions(slips_at(t_F))))
     x = x + position_noise * rng.standard_normal(x.shape)
     F = F + force_noise * rng.standard_normal(F.shape)
     return ExperimentRecord(t_F=t_F, F=F, t_x=t_x, x=x, n=n, n_slabs=apparatus.n_slabs, protocol=protocol, a=a,

@@ -1,0 +1,203 @@
+"""Inertial dynamics of the slabs on rate-and-state interfaces, integrated by an implicit stiff ODE method.
+
+The slippable interfaces ``s_1 < ... < s_m`` of an :class:`.apparatus.Apparatus` (the stack:
+1..n; the individual protocol: a) cut the stack into ``m`` rigid bodies: body ``k`` holds slabs
+``s_k .. s_{k+1} - 1`` (the last one every slab above ``s_m`` and the dead weight; the slabs below
+``s_1`` are clamped to the base). Body ``k`` moves at ``u_k = V_1 + ... + V_k`` (``V_l`` the slip
+rate of interface ``s_l``) and obeys Newton's law::
+
+    M_k du_k/dt = S_k - N mu_k + N mu_{k+1}          (mu_{m+1} = 0)
+
+with ``S_k`` the spring forces on its driven slabs (:meth:`.apparatus.Apparatus.spring_forces`, ``K
+(j h gamma(t) - x_j)``) and ``N mu_k`` the friction of interface ``s_k``
+(:class:`.rate_state.RateStateLaw`; the same normal force ``N`` on every interface, as in the
+statics). In quasi-static equilibrium ``mu_k`` equals the apparatus's ``mu_i = sum_{j >= i} f_j / N``.
+
+State vector ``y = [R_S, V_S, psi_S, gamma]`` (3 m + 1 values, :mod:`.slab_equations`): slips
+[mm], slip rates [mm/s], ``psi = ln(V0 theta / D_c)``, lever rotation [rad]. The system is very
+stiff while the interfaces stick (the friction's stiffness ``N a / V`` with ``V`` down to nm/s
+gives rates ~1e12 /s) and fast during a slip (ms), so it is integrated with an implicit method
+with the analytic Jacobian: the compiled L-stable Rosenbrock method :mod:`.rosenbrock` (default),
+or ``scipy.integrate.solve_ivp``'s Radau, BDF, LSODA (same results, ~100 times slower a step in
+Python); an explicit method would need time steps below 1e-12 s.
+
+Units: lengths [mm], forces [N], masses [kg] (accelerations ``1000 F / M`` [mm/s^2]), time [s].
+"""
+
+import dataclasses
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from . import rosenbrock
+from .slab_equations import friction as _friction, jacobian as _jacobian, rhs as _rhs
+
+__all__ = ["SlabDynamics", "METHODS", "DEFAULT_METHOD"]
+
+#: Implicit methods: the numba-compiled Rosenbrock method, and those of scipy.integrate.solve_ivp.
+METHODS = ("ROS2", "Radau", "BDF", "LSODA")
+#: The method of the solver (docs/experiment-model-rate-state.md: 100 times faster than Radau per step).
+DEFAULT_METHOD = "ROS2"
+#: mm/s^2 per N/kg.
+MM_PER_M = 1000.0
+
+
+@dataclasses.dataclass(frozen=True)
+class SlabDynamics:
+    """Equations of motion of the bodies above the slippable interfaces.
+
+    Attributes
+    ----------
+    apparatus : Apparatus
+    law : RateStateLaw
+        Parameters of every interface (only the slippable ones are used).
+    slab_mass : float
+        Mass of one slab [kg].
+    load_mass : float
+        Mass of the dead weight on the top slab [kg].
+    """
+
+    apparatus: object
+    law: object
+    slab_mass: float
+    load_mass: float
+
+    @property
+    def interfaces(self):
+        """0-based slippable interfaces, int [m]."""
+        return np.asarray(self.apparatus.slippable, dtype=int) - 1
+
+    @property
+    def masses(self):
+        """Mass of every body [kg], [m]: its slabs, and the dead weight for the top one."""
+        s = self.interfaces
+        upper = np.append(s[1:], self.apparatus.n_slabs)
+        masses = (upper - s) * self.slab_mass
+        masses[-1] += self.load_mass
+        return masses
+
+    def _matrices(self):
+        s, n_slabs = self.interfaces, self.apparatus.n_slabs
+        m = s.size
+        upper = np.append(s[1:], n_slabs)
+        body_of_slab = np.full(n_slabs, -1)
+        for k in range(m):
+            body_of_slab[s[k]:upper[k]] = k
+        heights = self.apparatus.heights
+        driven = heights > 0
+        K = self.apparatus.k_spring
+        drive = np.zeros(m)              # S_k = drive_k gamma(t) - (stiffness @ R)_k
+        n_driven = np.zeros(m)
+        for j in range(n_slabs):
+            if driven[j] and body_of_slab[j] >= 0:
+                drive[body_of_slab[j]] += K * heights[j]
+                n_driven[body_of_slab[j]] += 1
+        lower = np.tril(np.ones((m, m)))
+        stiffness = K * n_driven[:, None] * lower
+        difference = np.linalg.inv(lower)               # V = D u
+        reaction = np.eye(m) - np.eye(m, k=1)           # friction of interface k minus that of k + 1
+        inverse_mass = MM_PER_M / self.masses
+        return drive, stiffness, difference * inverse_mass[None, :], reaction
+
+    def __post_init__(self):
+        drive, stiffness, accel, reaction = self._matrices()
+        s = self.interfaces
+        object.__setattr__(self, "_drive", drive)
+        object.__setattr__(self, "_stiffness", stiffness)
+        object.__setattr__(self, "_accel", accel)              # D M^-1 [mm/s^2 per N]
+        object.__setattr__(self, "_friction_matrix", self.apparatus.normal_force * reaction)
+        for name in ("a", "b", "D_c", "mu0"):
+            object.__setattr__(self, "_" + name, np.asarray(getattr(self.law, name), dtype=float)[s])
+
+    def _arrays(self):
+        return (self._drive, self._stiffness, self._accel, self._friction_matrix, self._mu0, self._a, self._b,
+                self._D_c, float(self.law.V0))
+
+    def friction(self, V, psi):
+        """Friction coefficients of the slippable interfaces at slip rates ``V`` [mm/s] and states ``psi``, [m]."""
+        return _friction(np.asarray(V, dtype=float), np.asarray(psi, dtype=float), self._mu0, self._a, self._b,
+                         float(self.law.V0))
+
+    def rhs(self, y, rate):
+        """dy/dt of the state ``y = [R, V, psi, gamma]`` [3 m + 1] with the lever turning at ``rate`` [1/s]."""
+        return _rhs(y, rate, *self._arrays())
+
+    def jacobian(self, y, rate):
+        """d(dy/dt)/dy, float64 [3 m + 1, 3 m + 1]."""
+        return _jacobian(y, rate, *self._arrays())
+
+    def initial_state(self, V_start, theta_start, gamma_start):
+        """State at rest in equilibrium: slip rates ``V_start`` [mm/s] and contact ages ``theta_start`` [s]
+        of the slippable interfaces, lever rotation ``gamma_start`` [rad], and the slips that make the
+        springs balance the friction.
+
+        Returns
+        -------
+        R0 : numpy.ndarray
+            Slip of every interface [mm], [n_slabs] (at ``gamma_start``).
+        y0 : numpy.ndarray
+            State vector ``[R_S, V_S, psi_S, gamma]``, [3 m + 1].
+        """
+        V = np.broadcast_to(np.asarray(V_start, dtype=float), self._a.shape)
+        psi = np.broadcast_to(np.log(self.law.V0 * np.asarray(theta_start, dtype=float) / self._D_c), self._a.shape)
+        target = np.zeros(self.apparatus.n_slabs)
+        target[self.interfaces] = self.friction(V, psi)
+        shifted = dataclasses.replace(self.apparatus, gamma_start=gamma_start)
+        R0 = shifted.relaxed_slips(target)
+        return R0, np.concatenate([R0[self.interfaces], V, psi, [gamma_start]])
+
+    def tolerances(self, R=1e-6, V=1e-9, psi=1e-4):
+        """Absolute tolerances of the state components: slips ``R`` [mm], slip rates ``V`` [mm/s], states
+        ``psi`` (and 1e-12 rad for gamma), float64 [3 m + 1]."""
+        m = self.interfaces.size
+        return np.concatenate([np.full(m, R), np.full(m, V), np.full(m, psi), [1e-12]])
+
+    def integrate(self, y0, duration, rate, *, method=DEFAULT_METHOD, rtol=1e-4, atol=None):
+        """Integrate ``duration`` [s] from ``y0`` with the lever turning at ``rate`` [1/s].
+
+        Parameters
+        ----------
+        y0 : numpy.ndarray
+            Initial state [3 m + 1] (:meth:`initial_state`, or the last state of a previous call).
+        duration : float
+            [s] (> 0).
+        rate : float
+            d gamma / dt [1/s] (0: a hold).
+        method : {"ROS2", "Radau", "BDF", "LSODA"}
+            "ROS2": the numba-compiled L-stable Rosenbrock method :func:`rosenbrock.ros2`; the others:
+            ``scipy.integrate.solve_ivp`` (:data:`METHODS`).
+        rtol : float
+            Relative tolerance of the step control.
+        atol : numpy.ndarray, optional
+            Absolute tolerances [3 m + 1]; default :meth:`tolerances`.
+
+        Returns
+        -------
+        t : numpy.ndarray
+            Accepted step times from 0 [s], [n_steps + 1].
+        y : numpy.ndarray
+            States there, [n_steps + 1, 3 m + 1].
+        dydt : numpy.ndarray
+            Their time derivatives, [n_steps + 1, 3 m + 1] (for Hermite interpolation).
+
+        Raises
+        ------
+        RuntimeError
+            If the integrator fails.
+        """
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
+        y0 = np.ascontiguousarray(y0, dtype=float)
+        atol = self.tolerances() if atol is None else np.ascontiguousarray(atol, dtype=float)
+        if method == "ROS2":
+            t, y, dydt, ok = rosenbrock.ros2(y0, float(duration), (float(rate), *self._arrays()),
+                                             rtol, atol)
+            if not ok:
+                raise RuntimeError(f"rate-and-state integration failed at t = {t[-1]:.6g} s: step size underflow")
+            return t, y, dydt
+        solution = solve_ivp(lambda t, y: self.rhs(y, rate), (0.0, duration), y0, method=method, rtol=rtol,
+                             atol=atol, jac=lambda t, y: self.jacobian(y, rate))
+        if not solution.success:
+            raise RuntimeError(f"rate-and-state integration failed at t = {solution.t[-1]:.6g} s: {solution.message}")
+        y = solution.y.T
+        return solution.t, y, np.array([self.rhs(row, rate) for row in y])
