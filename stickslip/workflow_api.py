@@ -26,6 +26,7 @@ from .h5io import FileFormatError, open_file
 from .params import params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import recording, sha256_file
+from .termination import sigterm_as_interrupt
 
 __all__ = ["prepare_environment", "partial_path", "run_mesh", "run_simulation", "run_analysis", "run_figure",
            "build_database"]
@@ -69,11 +70,14 @@ def prepare_environment(threads, numba_cache=""):
 
 @contextlib.contextmanager
 def _logged(log):
-    """Send stdout and stderr to ``log``; a failure's traceback goes there too, then propagates."""
+    """Send stdout and stderr to ``log``; a failure's traceback goes there too, then propagates.
+
+    SIGTERM (Snakemake, ``scancel``, a wall time) ends the job as Ctrl-C does: files are closed.
+    """
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w", encoding="utf-8") as stream:
         try:
-            with contextlib.redirect_stdout(stream), contextlib.redirect_stderr(stream):
+            with contextlib.redirect_stdout(stream), contextlib.redirect_stderr(stream), sigterm_as_interrupt():
                 yield stream
         except BaseException:
             stream.write(traceback.format_exc())

@@ -3,7 +3,9 @@
 Each module in :data:`COMMANDS` defines ``add_parser(subparsers)``, which adds its
 sub-command and sets ``func(args) -> int`` as the parser default. Errors of the
 user's making (bad parameter, unknown plugin, unreadable file) are printed as one
-line ``stickslip: error: ...`` with exit status 2, never as a traceback.
+line ``stickslip: error: ...`` with exit status 2, never as a traceback. Ctrl-C and
+SIGTERM end a command cleanly (files closed, what a run stored is kept) with exit
+status 130 (SIGINT) or 143 (SIGTERM).
 """
 
 import argparse
@@ -13,6 +15,7 @@ import sys
 from ..h5io import FileFormatError
 from ..params import ParameterError
 from ..registry import PluginError
+from ..termination import exit_status, interruption, sigterm_as_interrupt
 
 __all__ = ["main", "COMMANDS"]
 
@@ -39,10 +42,18 @@ def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args) or 0
+        with sigterm_as_interrupt():
+            return args.func(args) or 0
     except USER_ERRORS as error:
         print(f"stickslip: error: {error}", file=sys.stderr)
         return 2
+    except BaseException as error:
+        interrupt = interruption(error)
+        if interrupt is None:
+            raise
+        cause = str(interrupt) or "interrupted"
+        print(f"stickslip: {cause}; what was stored is kept (a simulation resumes when rerun)", file=sys.stderr)
+        return exit_status(interrupt)
 
 
 if __name__ == "__main__":

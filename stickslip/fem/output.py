@@ -28,14 +28,14 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from ..h5io import FileFormatError, open_file, read_table, write_attrs, write_dataset
+from ..h5io import FileFormatError, atomic_output, copy_file, open_file, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
 from ..params import parse_params, params_to_dict
 from .stiffness import driving_regime, stiffness_ratio
 from .observables import observable_columns
 from .parameters import FemParams
 
-__all__ = ["create_file", "append_increment", "read_increments", "read_run_attrs", "read_params", "RunFile",
+__all__ = ["create_file", "append_increment", "rewrite", "read_increments", "read_run_attrs", "read_params", "RunFile",
            "rerun_with_failures"]
 
 _STATE = ("u", "target", "lever_target", "t")
@@ -91,7 +91,11 @@ def _append(dataset, value):
 
 
 def append_increment(file, system, row):
-    """Append one increment (state and observables) and flush.
+    """Append one increment (state and observables) and commit it.
+
+    The rows are flushed first, then ``nstored`` is raised and flushed: a process
+    killed at any moment leaves at most rows beyond ``nstored``, which readers and
+    :func:`rewrite` ignore.
 
     Parameters
     ----------
@@ -106,18 +110,31 @@ def append_increment(file, system, row):
     table = file["increments"]
     for name in json.loads(table.attrs["columns"]):
         _append(table[name], row[name])
+    file.flush()
     file.attrs["nstored"] = int(file["state/t"].shape[0])
     file.flush()
 
 
-def truncate_to_stored(file):
-    """Drop a partly written increment (rows beyond the ``nstored`` attribute)."""
-    n = int(file.attrs["nstored"])
-    groups = [file["state"][name] for name in _STATE]
-    groups += [file["increments"][name] for name in json.loads(file["increments"].attrs["columns"])]
-    for dataset in groups:
-        if dataset.shape[0] != n:
-            dataset.resize(n, axis=0)
+def rewrite(path, **attrs):
+    """Rewrite a simulation file from its complete increments, atomically.
+
+    Rows beyond ``nstored`` (an increment being written when the writer was
+    killed) are dropped, and the file is written afresh with
+    :func:`stickslip.h5io.copy_file`, so its bytes depend only on the stored
+    increments, not on how often the run was interrupted. A file left "open for
+    write" by a killed process comes back writable.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A simulation file (not open elsewhere).
+    **attrs
+        Root attributes to set in the copy (e.g. ``completed``, ``stop_reason``).
+    """
+    with open_file(path) as source, atomic_output(path) as tmp:
+        with open_file(tmp, "w") as target:
+            copy_file(source, target, rows=int(source.attrs["nstored"]))
+            write_attrs(target, attrs)
 
 
 def read_params(file):
@@ -179,8 +196,7 @@ def read_increments(path):
     """
     with open_file(path) as file:
         read_params(file)
-        table = read_table(file, "increments")
-        return table.iloc[: int(file.attrs["nstored"])].reset_index(drop=True)
+        return read_table(file, "increments", rows=int(file.attrs["nstored"]))
 
 
 def read_run_attrs(path):
@@ -233,7 +249,7 @@ def rerun_with_failures(path, increment):
 
     with open_file(path) as file:
         run = RunFile(file)
-        table = read_table(file, "increments")
+        table = read_table(file, "increments", rows=run.nstored)
         if not 1 <= increment < run.nstored or not bool(table["kick"][increment]):
             raise FileFormatError(f"{path}: increment {increment} is not a stored kick increment")
         yield_element = bool(table["yield_element"][increment])

@@ -7,25 +7,27 @@ the brink of yielding (odd increments), and a kick followed by minimisation
 redone so that a whole element yields (``yield_element``). The run stops, and
 is marked completed, when a block comes within ``margin`` wells of the end of
 its yield strains (during a minimisation, or after a load step), or after
-``max_increments`` increments. Every increment is appended and flushed; an
-interrupted run resumes from its last complete increment and gives the same
-file contents as an uninterrupted run. Progress (increments, slip events so far,
-increments/s, time left when ``max_increments`` bounds the run) goes to stderr
-through :mod:`stickslip.progress`.
+``max_increments`` increments. Every increment is appended and committed; a run
+ended in any way (exception, SIGINT, SIGTERM, SIGKILL) resumes from its last
+committed increment and gives the same file, byte for byte, as an uninterrupted
+run. Progress (increments, slip events so far, increments/s, time left when
+``max_increments`` bounds the run) goes to stderr through :mod:`stickslip.progress`.
 Reference: shared/reference-model.md, section 8c.
 """
 
 import json
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from .. import progress
-from ..h5io import FileFormatError, atomic_output, open_file
+from ..h5io import FileFormatError, UnreadableFileError, atomic_output, open_file, writer_lock
 from ..params import params_to_dict
 from .minimise import within_margin
 from .observables import Observer
-from .output import RunFile, append_increment, create_file, read_params, truncate_to_stored
+from .output import RunFile, append_increment, create_file, read_params, rewrite
 from .system import System
 
 __all__ = ["run_simulation"]
@@ -72,8 +74,50 @@ def _create(path, params, mesh, threads):
             append_increment(file, system, _row(observer, 0, True, False, observer.well_index()))
 
 
+def _stored(output, params):
+    """Whether ``output`` holds a completed run; an unreadable file is moved aside (with a message).
+
+    Returns
+    -------
+    bool or None
+        ``completed`` of the stored run, None if there is none (any more).
+    """
+    if not output.exists():
+        return None
+    try:
+        with open_file(output) as file:
+            stored = read_params(file)
+            completed = bool(file.attrs["completed"])
+    except UnreadableFileError as error:
+        aside = _aside(output)
+        os.replace(output, aside)
+        print(f"stickslip: {error}; moved it to {aside}, starting the run over", file=sys.stderr)
+        return None
+    if params_to_dict(stored) != params_to_dict(params):
+        raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
+    return completed
+
+
+def _aside(path):
+    """A free name ``<name>.unreadable[-<k>]`` beside ``path``."""
+    aside = path.with_name(f"{path.name}.unreadable")
+    k = 1
+    while aside.exists():
+        k += 1
+        aside = path.with_name(f"{path.name}.unreadable-{k}")
+    return aside
+
+
 def run_simulation(params, output, mesh, threads=1):
     """Run (or resume, or skip if completed) one simulation into ``output``.
+
+    While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,
+    e.g. by ``stickslip increments``), one committed increment at a time. However
+    the run ends (an exception, SIGINT, SIGTERM, SIGKILL), the next call rewrites
+    the file from its committed increments (:func:`.output.rewrite`) and resumes;
+    a file that HDF5 cannot open is moved aside with a message and the run starts
+    over. A finished run is rewritten once more, so that the file has the same bytes
+    however often the run was interrupted.
 
     Parameters
     ----------
@@ -93,18 +137,27 @@ def run_simulation(params, output, mesh, threads=1):
     Raises
     ------
     FileFormatError
-        If ``output`` exists with other parameters, or is not a simulation file.
+        If ``output`` exists with other parameters, is not a simulation file, or
+        another process is writing it.
     """
     output = Path(output)
-    if not output.exists():
-        _create(output, params, mesh, threads)
-    with open_file(output, "r") as file:  # read-only first: a completed file is not touched
-        if params_to_dict(read_params(file)) != params_to_dict(params):
-            raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
-        if bool(file.attrs["completed"]):
+    with writer_lock(output):
+        completed = _stored(output, params)
+        if completed:
             return 0
+        if completed is None:
+            _create(output, params, mesh, threads)
+        else:
+            rewrite(output)
+        new, reason = _increments(params, output, threads)
+        rewrite(output, completed=True, stop_reason=reason)
+        return new
+
+
+def _increments(params, output, threads):
+    """Append increments to ``output`` until the run stops; return (number appended, stop reason)."""
     with open_file(output, "r+") as file:
-        truncate_to_stored(file)
+        file.swmr_mode = True
         run = RunFile(file)
         system = System(params, run.mesh, threads=threads)
         system.set_linear_response(*run.linear_response())
@@ -138,6 +191,4 @@ def run_simulation(params, output, mesh, threads=1):
             new += 1
             report.stored(file, increment)
         report.bar.close()
-        file.attrs["completed"] = True
-        file.attrs["stop_reason"] = reason
-        return new
+        return new, reason

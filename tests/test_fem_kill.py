@@ -1,0 +1,131 @@
+"""A fem run ended in any way (SIGTERM, SIGKILL, a workflow job killed) resumes to the same bytes.
+
+Real processes are started and killed at several points of the reference case; the
+killed files are rerun by the same command and compared, byte for byte, with an
+uninterrupted run. While a run is going its file is read (SWMR), as
+``stickslip increments`` does.
+"""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from stickslip import registry
+from stickslip.cli import main
+from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.h5io import FileFormatError, UnreadableFileError
+from stickslip.params import parse_params
+from stickslip.workflow_api import partial_path
+
+pytestmark = pytest.mark.slow
+
+CASE = {"N": 9, "nchunk": 200}  # the paper's reference case: 350 increments
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    path = tmp_path_factory.mktemp("fem") / "run.h5"
+    plugin = registry.get("solver", "fem")
+    plugin.run(parse_params(plugin.params, CASE), path, threads=1, inputs={})
+    return path
+
+
+def _cli(output):
+    params = [arg for key, value in CASE.items() for arg in ("--param", f"{key}={value}")]
+    return [sys.executable, "-m", "stickslip", "simulate", "--solver", "fem", *params, "-o", str(output)]
+
+
+def _workflow_job(output):
+    code = ("import sys, json; from stickslip.workflow_api import run_simulation; "
+            "run_simulation('fem', sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], inputs={}, threads=1)")
+    return [sys.executable, "-c", code, json.dumps(CASE), str(output), str(output.with_suffix(".json")),
+            str(output.with_suffix(".log"))]
+
+
+def _kill_when_stored(command, watched, increments, signum, timeout=600):
+    """Start ``command``, wait until ``watched`` holds ``increments`` increments, send ``signum``.
+
+    Returns
+    -------
+    (int, str, int)
+        Exit status, standard error, increments stored when the signal was sent.
+    """
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, env={**os.environ, "NUMBA_NUM_THREADS": "1"})
+    deadline = time.monotonic() + timeout
+    stored = 0
+    while time.monotonic() < deadline and process.poll() is None:
+        try:
+            stored = len(read_increments(watched))  # the running file is readable (SWMR)
+        except FileFormatError:
+            stored = 0  # not created yet
+        if stored >= increments:
+            break
+        time.sleep(0.05)
+    assert process.poll() is None, f"the run ended before {increments} increments: {process.stderr.read()}"
+    process.send_signal(signum)
+    _, err = process.communicate(timeout=120)
+    return process.returncode, err, stored
+
+
+def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(uninterrupted, tmp_path):
+    output = tmp_path / "run.h5"
+    status, err, _ = _kill_when_stored(_cli(output), output, 40, signal.SIGTERM)
+    assert status == 128 + signal.SIGTERM, err
+    assert "terminated by SIGTERM" in err and "Traceback" not in err
+    for increments in (150, 260):  # as by a cluster's wall time after its grace period, or the OOM killer
+        status, _, stored = _kill_when_stored(_cli(output), output, increments, signal.SIGKILL)
+        assert status == -signal.SIGKILL
+        assert not read_run_attrs(output)["completed"] and read_run_attrs(output)["nstored"] >= stored
+    done = subprocess.run(_cli(output), capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert output.read_bytes() == uninterrupted.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"]  # no lock or temporary file left
+
+
+def test_a_killed_workflow_job_resumes_to_the_same_bytes(uninterrupted, tmp_path):
+    output = tmp_path / "sim" / "fem" / "run.h5"
+    partial = partial_path(output)
+    for signum, increments in ((signal.SIGKILL, 100), (signal.SIGTERM, 220)):
+        status, _, _ = _kill_when_stored(_workflow_job(output), partial, increments, signum)
+        assert status != 0
+        assert not output.exists() and partial.exists()
+    assert "terminated by SIGTERM" in output.with_suffix(".log").read_text()
+    done = subprocess.run(_workflow_job(output), capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "resuming from" in output.with_suffix(".log").read_text()
+    assert output.read_bytes() == uninterrupted.read_bytes() and not partial.exists()
+
+
+def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(uninterrupted, tmp_path, capsys):
+    output = tmp_path / "run.h5"
+    output.write_bytes(uninterrupted.read_bytes()[:5000])  # truncated: HDF5 cannot open it
+    with pytest.raises(UnreadableFileError):
+        read_increments(output)
+    assert main(["simulate", "--solver", "fem", "--param", "N=9", "--param", "nchunk=200", "-o", str(output)]) == 0
+    err = capsys.readouterr().err
+    assert f"moved it to {output}.unreadable, starting the run over" in err
+    assert output.read_bytes() == uninterrupted.read_bytes()
+    assert (tmp_path / "run.h5.unreadable").stat().st_size == 5000
+
+
+def test_a_file_another_process_writes_is_refused(tmp_path):
+    from stickslip.h5io import writer_lock
+
+    output = tmp_path / "run.h5"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from stickslip.h5io import writer_lock\n"
+                               f"with writer_lock({str(output)!r}):\n print('locked', flush=True); time.sleep(60)"],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(FileFormatError, match="another process is writing it"), writer_lock(output):
+            pass
+    finally:
+        holder.kill()
+        holder.wait()
+    with writer_lock(output):  # the lock of a killed process is free
+        pass
