@@ -61,8 +61,11 @@ def open_file(path, mode="r"):
     -------
     h5py.File
 
-    Reading (``"r"``) a file whose writer is running, or was killed, in SWMR mode
-    opens it as an SWMR reader: it shows what the writer had flushed.
+    Reading (``"r"``) takes no HDF5 file lock, so that a reader never stops a writer
+    from opening the file (every writer of the package either writes a temporary
+    file and renames it, :func:`atomic_output`, or appends under
+    :func:`writer_lock`). A file whose writer is running, or was killed, in SWMR
+    mode is opened as an SWMR reader: it shows what the writer had flushed.
 
     Raises
     ------
@@ -75,12 +78,13 @@ def open_file(path, mode="r"):
     if mode in ("r", "r+"):
         if not path.is_file():
             raise FileFormatError(f"{path}: no such file")
+        reading = {"locking": False} if mode == "r" else {"libver": LIBVER}
         try:
-            return h5py.File(path, mode, libver=LIBVER if mode == "r+" else None)
+            return h5py.File(path, mode, **reading)
         except OSError as error:
             if mode == "r" and _OPEN_FOR_WRITE in str(error):
                 try:
-                    return h5py.File(path, "r", swmr=True)
+                    return h5py.File(path, "r", swmr=True, **reading)
                 except OSError:
                     pass
             raise UnreadableFileError(f"{path}: not a readable HDF5 file ({error})") from error
