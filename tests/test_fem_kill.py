@@ -24,7 +24,7 @@ from stickslip.workflow_api import partial_path
 
 pytestmark = pytest.mark.slow
 
-CASE = {"N": 9, "nchunk": 200}  # the paper's reference case: 350 increments
+CASE = {"N": 9, "nchunk": 200, "yield_strains": "stop"}  # the paper's reference case: 350 increments
 
 
 @pytest.fixture(scope="module")

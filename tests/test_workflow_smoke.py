@@ -1,5 +1,6 @@
 """Smoke test: the real ci study (workflow/config/ci.yaml) end to end with `snakemake --cores 2`."""
 
+import re
 import sqlite3
 
 import pytest
@@ -23,9 +24,9 @@ def test_ci_study_end_to_end(tmp_path):
     # every job's log shows its progress, ending with the whole work done
     for sim in study.simulations:
         log = (directory / study.log(f"sim/{sim.solver}/{sim.run_id}")).read_text()
-        done = {"fem": "fem increments: 200/200 increment (100%)",
-                "lever": f"virtual experiment: {sim.params['duration']:.0f}/{sim.params['duration']:.0f} s simulated (100%)"}
-        assert done[sim.solver] in log, log
+        done = {"fem": r"fem increments: 200/200 increment \(100%\)",
+                "lever": r"virtual experiment: (\d+)/\1 s simulated \(100%\)"}
+        assert re.search(done[sim.solver], log), log
     records_count = len(study.records())
     assert f"ingest: {records_count}/{records_count} record (100%)" in (directory / study.log("database")).read_text()
     records = sorted(results.rglob("*.provenance.json"))
