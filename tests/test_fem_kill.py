@@ -35,9 +35,13 @@ def uninterrupted(tmp_path_factory):
     return path
 
 
-def _cli(output):
+def _simulate_args(output):
     params = [arg for key, value in CASE.items() for arg in ("--param", f"{key}={value}")]
-    return [sys.executable, "-m", "stickslip", "simulate", "--solver", "fem", *params, "-o", str(output)]
+    return ["simulate", "--solver", "fem", *params, "-o", str(output)]
+
+
+def _cli(output):
+    return [sys.executable, "-m", "stickslip", *_simulate_args(output)]
 
 
 def _workflow_job(output):
@@ -106,7 +110,7 @@ def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(uninterrupted
     output.write_bytes(uninterrupted.read_bytes()[:5000])  # truncated: HDF5 cannot open it
     with pytest.raises(UnreadableFileError):
         read_increments(output)
-    assert main(["simulate", "--solver", "fem", "--param", "N=9", "--param", "nchunk=200", "-o", str(output)]) == 0
+    assert main(_simulate_args(output)) == 0
     err = capsys.readouterr().err
     assert f"moved it to {output}.unreadable, starting the run over" in err
     assert output.read_bytes() == uninterrupted.read_bytes()
