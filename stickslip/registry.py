@@ -2,11 +2,15 @@
 
 A plugin is one function plus its identity: name (a path component of its
 outputs), version (part of the run id: a new version reruns what it produced),
-a parameter dataclass (see :mod:`stickslip.params`) and, for analyses and
-figures, the categories of input it reads.
+a parameter dataclass (see :mod:`stickslip.params`) and its contract: the
+artifact formats it consumes and produces (:mod:`stickslip.formats`); a figure
+declares the input categories it reads. The study wires stages by format, never
+by plugin name: an analysis that consumes ``fem-run`` runs on the output of every
+solver that produces ``fem-run``.
 
-Built-in plugins register with a decorator in the modules listed in
-:data:`BUILTIN_MODULES`; third-party packages add an entry point in the group
+Built-in plugins register with a decorator in the modules of the packages
+:data:`BUILTIN_PACKAGES` (every module there is imported: a new module is found
+without editing a list); third-party packages add an entry point in the group
 of the plugin's kind (:data:`ENTRY_POINT_GROUPS`) that names the module to import
 (importing it runs its decorators), e.g. in their ``pyproject.toml``::
 
@@ -15,53 +19,52 @@ of the plugin's kind (:data:`ENTRY_POINT_GROUPS`) that names the module to impor
 
 Call signatures by kind (checked when a plugin registers):
 
-- ``solver``: ``run(params, output, *, threads, inputs)``: write one simulation
-  file ``output`` (:class:`pathlib.Path`, HDF5) using at most ``threads``
-  threads; ``inputs`` maps each declared input category (e.g. ``"mesh"``) to a
-  path made by an upstream stage, and may be empty (the solver then makes what
-  it needs itself).
-- ``analysis``: ``run(params, input, output)``: read one solver output, write one
-  HDF5 table file.
+- ``solver``: ``run(params, output, *, threads, inputs)``: write one file of the
+  format it produces, ``output`` (:class:`pathlib.Path`, HDF5), using at most
+  ``threads`` threads; ``inputs`` maps each consumed format (e.g. ``"mesh"``) to
+  a file made by an upstream stage, and may be empty (the solver then makes what
+  it needs itself). A solver may offer ``replay(path)``: an object whose
+  ``failures(increment)`` re-runs one stored event of a file it wrote.
+- ``analysis``: ``run(params, input, output)``: read one simulation (a
+  :class:`stickslip.lineage.Artifact`: path-like, with the run id and the solver
+  that wrote it), write one file of the format it produces.
 - ``figure``: ``run(params, inputs, output)``: ``inputs`` maps each declared input
-  category to a list of paths; write ``output`` (PDF) and the PNG beside it.
+  category (``"analysis:<name>"``: every output of that analysis, each with its
+  simulation as ``parent``; ``"format:<name>"``: every simulation or mesh of that
+  format) to a list of artifacts; write ``output`` (PDF) and the PNG beside it.
 """
 
 import dataclasses
-import hashlib
 import importlib
 import inspect
-import json
+import pkgutil
 import re
 from collections.abc import Callable
 from importlib.metadata import entry_points
 
+from . import formats
+from .hashing import short_hash
 from .params import params_to_dict
 
 __all__ = [
     "KINDS",
     "ENTRY_POINT_GROUPS",
-    "BUILTIN_MODULES",
+    "BUILTIN_PACKAGES",
     "Plugin",
     "PluginError",
     "register",
     "get",
     "available",
     "run_id",
+    "derived_run_id",
 ]
 
 KINDS = ("solver", "analysis", "figure")
 
 ENTRY_POINT_GROUPS = {"solver": "stickslip.solvers", "analysis": "stickslip.analyses", "figure": "stickslip.figures"}
 
-#: Modules whose import registers the built-in plugins.
-BUILTIN_MODULES = ("stickslip.events.plugin", "stickslip.events.fronts", "stickslip.experiment.analysis",
-                   "stickslip.figures.mesh", "stickslip.solvers.lever", "stickslip.solvers.rate_state_lever", "stickslip.figures.fig2",
-                   "stickslip.figures.figs_dgamma", "stickslip.figures.figs_sequences",
-                   "stickslip.figures.figs_phi_sweep", "stickslip.figures.figs_event_maps", "stickslip.figures.figs_tau",
-                   "stickslip.figures.fig3", "stickslip.figures.fig4", "stickslip.figures.fig5",
-                   "stickslip.figures.fig6", "stickslip.figures.figs_individual",
-                   "stickslip.figures.figs_slip_distributions", "stickslip.figures.figs_aging_variations",
-                   "stickslip.figures.figs_slow_slip", "stickslip.solvers.fem")
+#: Packages whose modules hold the built-in plugins: importing each module registers them.
+BUILTIN_PACKAGES = ("stickslip.solvers", "stickslip.events", "stickslip.experiment", "stickslip.figures")
 
 _RUN_SIGNATURES = {
     "solver": (["params", "output"], ["threads", "inputs"]),
@@ -98,12 +101,15 @@ class Plugin:
         The plugin function, with the signature of its kind.
     summary : str
         One line for ``stickslip plugins``.
+    consumes : tuple[str, ...]
+        Formats read. Solvers: optional upstream files (``"mesh"``); analyses:
+        exactly one, the format of the simulations it analyses.
+    produces : str or None
+        Format of the output (solvers and analyses).
     inputs : tuple[str, ...]
-        Input categories. Solvers: optional upstream files (``"mesh"``).
-        Analyses: the solver names whose outputs it accepts. Figures: what it
-        reads, each ``"solver:<name>"`` (all outputs of that solver in the
-        study), ``"analysis:<name>"`` (all outputs of that analysis) or
-        ``"mesh"`` (all mesh files).
+        Figures: the input categories, each ``"analysis:<name>"`` or ``"format:<name>"``.
+    replay : Callable or None
+        Solvers: ``replay(path)`` re-runs stored events of a file the solver wrote.
     module : str
         Module that defined it.
     """
@@ -114,7 +120,10 @@ class Plugin:
     params: type
     run: Callable
     summary: str
+    consumes: tuple = ()
+    produces: str | None = None
     inputs: tuple = ()
+    replay: Callable | None = None
     module: str = ""
 
 
@@ -141,9 +150,35 @@ def _check_shape(plugin):
     if names != positional or any(k not in keywords for k in keyword):
         expected = ", ".join(positional + [f"*, {k}" for k in keyword])
         raise PluginError(f"{plugin.kind} {plugin.name!r}: run must have the signature ({expected}), got {signature}")
+    _check_contract(plugin)
 
 
-def register(kind, name, version, params, *, summary="", inputs=()):
+def _check_contract(plugin):
+    where = f"{plugin.kind} {plugin.name!r}"
+    for name in plugin.consumes + ((plugin.produces,) if plugin.produces else ()):
+        try:
+            formats.get_format(name)
+        except formats.FormatError as error:
+            raise PluginError(f"{where}: {error}") from None
+    if plugin.kind in ("solver", "analysis") and not plugin.produces:
+        raise PluginError(f"{where}: declare the format it produces (produces=...)")
+    if plugin.kind == "analysis" and len(plugin.consumes) != 1:
+        raise PluginError(f"{where}: declare the one format it consumes (consumes=(...,)), got {plugin.consumes}")
+    if plugin.kind == "figure":
+        if plugin.consumes or plugin.produces:
+            raise PluginError(f"{where}: a figure declares inputs=(...) categories, not formats")
+        for category in plugin.inputs:
+            kind, _, name = category.partition(":")
+            if kind not in ("analysis", "format") or not name:
+                raise PluginError(f"{where}: input category {category!r}: expected 'analysis:<name>' or "
+                                  "'format:<name>'")
+    elif plugin.inputs:
+        raise PluginError(f"{where}: only figures declare inputs=(...); solvers and analyses declare consumes")
+    if plugin.replay is not None and (plugin.kind != "solver" or not callable(plugin.replay)):
+        raise PluginError(f"{where}: replay must be a callable of a solver")
+
+
+def register(kind, name, version, params, *, summary="", consumes=(), produces=None, inputs=(), replay=None):
     """Decorator that registers a plugin function.
 
     Parameters
@@ -157,8 +192,8 @@ def register(kind, name, version, params, *, summary="", inputs=()):
         Parameter dataclass.
     summary : str, optional
         One line for listings; defaults to the first line of the docstring.
-    inputs : tuple[str, ...], optional
-        Input categories (see :class:`Plugin`).
+    consumes, produces, inputs, replay
+        The plugin's contract (see :class:`Plugin`).
 
     Returns
     -------
@@ -174,8 +209,8 @@ def register(kind, name, version, params, *, summary="", inputs=()):
     def decorator(function):
         doc = (inspect.getdoc(function) or "").strip().splitlines()
         plugin = Plugin(kind=kind, name=name, version=version, params=params, run=function,
-                        summary=summary or (doc[0] if doc else ""), inputs=tuple(inputs),
-                        module=function.__module__)
+                        summary=summary or (doc[0] if doc else ""), consumes=tuple(consumes), produces=produces,
+                        inputs=tuple(inputs), replay=replay, module=function.__module__)
         _check_shape(plugin)
         existing = _plugins[kind].get(name)
         if existing is not None and (existing.module, existing.run.__qualname__) != (
@@ -192,8 +227,10 @@ def _load():
     if _loaded:
         return
     _loaded = True
-    for module in BUILTIN_MODULES:
-        importlib.import_module(module)
+    for name in BUILTIN_PACKAGES:
+        package = importlib.import_module(name)
+        for module in pkgutil.iter_modules(package.__path__):
+            importlib.import_module(f"{name}.{module.name}")
     for kind, group in ENTRY_POINT_GROUPS.items():
         for entry in entry_points(group=group):
             try:
@@ -248,7 +285,27 @@ def run_id(plugin, params):
     str
         16 hexadecimal characters; equal inputs give equal ids.
     """
-    payload = {"kind": plugin.kind, "name": plugin.name, "version": plugin.version,
-               "params": params_to_dict(params)}
-    text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return short_hash({"kind": plugin.kind, "name": plugin.name, "version": plugin.version,
+                       "params": params_to_dict(params)})
+
+
+def derived_run_id(plugin, params, input_run_ids):
+    """Return the id of an analysis or figure run: its plugin, parameters and the run ids it reads.
+
+    The inputs enter through their lineage (run ids), not their bytes, so the study knows
+    every id before any job runs.
+
+    Parameters
+    ----------
+    plugin : Plugin
+    params : object
+        An instance of ``plugin.params``.
+    input_run_ids : Iterable[str]
+        Run ids of the files it reads (order does not matter).
+
+    Returns
+    -------
+    str
+        16 hexadecimal characters.
+    """
+    return short_hash({"run": run_id(plugin, params), "inputs": sorted(input_run_ids)})

@@ -16,9 +16,12 @@ Config layout (``workflow/config/*.yaml``, schema ``workflow/schemas/config.sche
 A run's parameters are its sweep's ``params`` and one combination of its
 ``grid`` (a parameter is named in one of the two, a grid value listed once:
 :func:`check_sweeps`); its id is :func:`stickslip.registry.run_id` of those parameters.
-An analysis runs on every simulation of the solvers it accepts; a figure reads
-every output of each input category it declares (``solver:<name>``,
-``analysis:<name>``, ``mesh``).
+Stages are wired by format (:mod:`stickslip.formats`): an analysis runs on every
+simulation whose solver produces the format it consumes, whatever the solver's
+name; a solver that consumes ``mesh`` gets the mesh of its parameters; a figure
+reads every output of each input category it declares (``analysis:<name>``, each
+output paired with its simulation, or ``format:<name>``). Every job's inputs are
+:class:`stickslip.lineage.Artifact` s: path, run id, producer, format, parent.
 
 Each study writes under its own results tree, ``results/{study}/``: outputs
 (:data:`PATHS`), logs and the database, so studies run in one clone never
@@ -32,6 +35,7 @@ import re
 from pathlib import Path
 
 from . import registry
+from .lineage import Artifact
 from .params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import record_path
@@ -97,24 +101,37 @@ class Simulation:
         Defaults-filled, JSON-safe parameters.
     path : str
         Output file.
+    format : str
+        Its format (the solver's ``produces``).
     mesh_id : str or None
-        Id of the mesh file it reads (solvers that declare the ``"mesh"`` input).
+        Id of the mesh file it reads (solvers that consume ``mesh``).
     """
 
     solver: str
     run_id: str
     params: dict
     path: str
+    format: str
     mesh_id: str | None = None
+
+    def artifact(self):
+        """The output as an :class:`~stickslip.lineage.Artifact`."""
+        return Artifact(self.path, self.run_id, self.solver, self.format)
 
 
 @dataclasses.dataclass(frozen=True)
 class AnalysisJob:
-    """One analysis of one simulation output (``path``: the output file)."""
+    """One analysis of one simulation output (``path``: the output file, of ``format``)."""
 
     analysis: str
     simulation: Simulation
+    run_id: str
     path: str
+    format: str
+
+    def artifact(self):
+        """The output as an :class:`~stickslip.lineage.Artifact`, its simulation as parent."""
+        return Artifact(self.path, self.run_id, self.analysis, self.format, self.simulation.artifact())
 
 
 @dataclasses.dataclass(frozen=True)
@@ -125,16 +142,23 @@ class FigureJob:
     ----------
     figure : str
     params : dict
-    inputs : dict[str, list[str]]
-        Input category -> sorted paths.
+    inputs : dict[str, list[stickslip.lineage.Artifact]]
+        Input category -> artifacts sorted by path.
     path : str
         Output PDF (the PNG is beside it).
+    run_id : str
     """
 
     figure: str
     params: dict
     inputs: dict
     path: str
+    run_id: str
+
+    def files(self):
+        """Every file it reads (analysis outputs and their simulations), sorted, no duplicates."""
+        return sorted({path.as_posix() for items in self.inputs.values() for item in items
+                       for path in item.files()})
 
 
 def _where(section, name, *rest):
@@ -301,7 +325,7 @@ class Study:
         runs = {}
         for name, sweeps in solvers.items():
             plugin = _plugin("solver", name, _where("solvers", name))
-            unknown = sorted(set(plugin.inputs) - {"mesh"})
+            unknown = sorted(set(plugin.consumes) - {"mesh"})
             if unknown:
                 raise ParameterError(f"config solvers.{name}: the workflow cannot make the input(s) "
                                      f"{', '.join(unknown)} that solver '{name}' declares (it makes: mesh)")
@@ -314,35 +338,43 @@ class Study:
                     run = registry.run_id(plugin, params)
                     as_dict = params_to_dict(params)
                     mesh_id = None
-                    if "mesh" in plugin.inputs:
+                    if "mesh" in plugin.consumes:
                         mesh_id, mesh_params = _mesh_for(as_dict)
                         self.meshes[mesh_id] = mesh_params
-                    runs[(name, run)] = Simulation(name, run, as_dict,
-                                                   self.path("simulation", solver=name, run_id=run), mesh_id)
+                    runs[(name, run)] = Simulation(name, run, as_dict, self.path("simulation", solver=name, run_id=run),
+                                                   plugin.produces, mesh_id)
         return [runs[key] for key in sorted(runs)]
 
     def _analyses(self, analyses):
         chosen, jobs = {}, []
         for name, values in analyses.items():
             plugin = _plugin("analysis", name, _where("analyses", name))
-            chosen[name] = params_to_dict(_parse(plugin, values, _where("analyses", name)))
-            mine = [AnalysisJob(name, sim, self.path("events", analysis=name, solver=sim.solver, run_id=sim.run_id))
-                    for sim in self.simulations if sim.solver in plugin.inputs]
+            params = _parse(plugin, values, _where("analyses", name))
+            chosen[name] = params_to_dict(params)
+            mine = [AnalysisJob(name, sim, registry.derived_run_id(plugin, params, [sim.run_id]),
+                                self.path("events", analysis=name, solver=sim.solver, run_id=sim.run_id),
+                                plugin.produces)
+                    for sim in self.simulations if sim.format in plugin.consumes]
             if not mine:
-                raise ParameterError(f"config analyses.{name}: it reads outputs of the solver(s) "
-                                     f"{', '.join(plugin.inputs) or '(none)'}, which the study does not run")
+                raise ParameterError(f"config analyses.{name}: it reads {', '.join(plugin.consumes)} files, which "
+                                     "no solver of the study produces")
             jobs.extend(mine)
         return chosen, jobs
 
-    def _category_paths(self, category):
+    def mesh_artifact(self, mesh_id):
+        """The mesh file of ``mesh_id`` as an :class:`~stickslip.lineage.Artifact`."""
+        return Artifact(self.path("mesh", mesh_id=mesh_id), mesh_id, "mesh", "mesh")
+
+    def _category(self, category):
+        """Artifacts of one figure input category, sorted by path."""
         kind, _, name = category.partition(":")
-        if category == "mesh":
-            return [self.path("mesh", mesh_id=m) for m in sorted(self.meshes)]
-        if kind == "solver":
-            return [sim.path for sim in self.simulations if sim.solver == name]
         if kind == "analysis":
-            return [job.path for job in self.analysis_jobs if job.analysis == name]
-        return None
+            found = [job.artifact() for job in self.analysis_jobs if job.analysis == name]
+        elif name == "mesh":
+            found = [self.mesh_artifact(m) for m in self.meshes]
+        else:
+            found = [sim.artifact() for sim in self.simulations if sim.format == name]
+        return sorted(found, key=lambda item: item.path)
 
     def _figures(self, figures):
         jobs = {}
@@ -351,15 +383,13 @@ class Study:
             params = params_to_dict(_parse(plugin, values, _where("figures", name)))
             inputs = {}
             for category in plugin.inputs:
-                paths = self._category_paths(category)
-                if paths is None:
-                    raise ParameterError(f"config figures.{name}: unknown input category {category!r} "
-                                         "(expected 'mesh', 'solver:<name>' or 'analysis:<name>')")
-                if not paths:
+                inputs[category] = self._category(category)
+                if not inputs[category]:
                     raise ParameterError(f"config figures.{name}: it reads {category} outputs, which the "
                                          "study does not produce (add the solver or analysis to the config)")
-                inputs[category] = sorted(paths)
-            jobs[name] = FigureJob(name, params, inputs, self.path("figure", figure=name))
+            run = registry.derived_run_id(plugin, parse_params(plugin.params, params),
+                                          [item.run_id for items in inputs.values() for item in items])
+            jobs[name] = FigureJob(name, params, inputs, self.path("figure", figure=name), run)
         return jobs
 
     # Look-ups used by the rules ------------------------------------------------------------
@@ -397,9 +427,16 @@ class Study:
         raise KeyError(f"no simulation {solver}/{run_id} in the study")
 
     def solver_inputs(self, solver, run_id):
-        """Return the upstream files of one simulation, by category (``{"mesh": path}`` or ``{}``)."""
+        """Return the upstream files of one simulation by format (``{"mesh": Artifact}`` or ``{}``)."""
         sim = self.simulation(solver, run_id)
-        return {} if sim.mesh_id is None else {"mesh": self.path("mesh", mesh_id=sim.mesh_id)}
+        return {} if sim.mesh_id is None else {"mesh": self.mesh_artifact(sim.mesh_id)}
+
+    def analysis_job(self, analysis, solver, run_id):
+        """Return the :class:`AnalysisJob` of an analysis on one simulation (KeyError if none)."""
+        for job in self.analysis_jobs:
+            if (job.analysis, job.simulation.solver, job.simulation.run_id) == (analysis, solver, run_id):
+                return job
+        raise KeyError(f"no analysis {analysis} of {solver}/{run_id} in the study")
 
     def outputs(self):
         """Return every output file of the study except the database (sorted)."""
@@ -434,6 +471,10 @@ class Study:
         return f"{plugin.summary} (figure plugin ``{plugin.name}`` version {plugin.version}, {plugin.module})"
 
     @staticmethod
-    def dumps(params):
-        """Return parameters as canonical JSON (what the rules pass to the jobs)."""
-        return json.dumps(params, sort_keys=True)
+    def dumps(value):
+        """Return parameters or lineage (artifacts, nested in dicts and lists) as JSON, keys sorted.
+
+        What the rules pass to the jobs; :meth:`stickslip.lineage.Artifact.from_dict` reads
+        an artifact back.
+        """
+        return json.dumps(value, sort_keys=True, default=Artifact.to_dict)

@@ -5,6 +5,9 @@ module, so everything a rule does can be run and tested without Snakemake.
 Every function writes a log, checks that its input files are readable HDF5
 (a corrupted file is reported by name before any work), runs the plugin, and
 writes the JSON record beside the output (:mod:`stickslip.provenance.record`).
+Jobs receive their inputs with their lineage (:class:`stickslip.lineage.Artifact`
+as JSON: run id, producer, format, parent) and record it; nothing is read back
+from a path.
 
 This module imports nothing that imports numba: :func:`prepare_environment`
 must set the numba variables before the first plugin is loaded.
@@ -12,7 +15,6 @@ must set the numba variables before the first plugin is loaded.
 
 import atexit
 import contextlib
-import hashlib
 import json
 import os
 import shutil
@@ -23,9 +25,10 @@ from pathlib import Path
 
 from . import registry
 from .h5io import FileFormatError, open_file
+from .lineage import Artifact
 from .params import params_to_dict, parse_params
 from .provenance.code import code_hash
-from .provenance.record import recording, sha256_file
+from .provenance.record import recording
 from .termination import sigterm_as_interrupt
 
 __all__ = ["prepare_environment", "partial_path", "run_mesh", "run_simulation", "run_analysis", "run_figure",
@@ -95,12 +98,16 @@ def _check_hdf5(role, path):
         raise FileFormatError(f"{path}: damaged HDF5 file ({error}) (input {role})") from None
 
 
-def _derived_run_id(plugin, params, input_files):
-    """Id of an analysis or figure run: plugin identity, parameters and the inputs' bytes."""
-    digest = hashlib.sha256(registry.run_id(plugin, params).encode())
-    for path in sorted(input_files):
-        digest.update(sha256_file(path).encode())
-    return digest.hexdigest()[:16]
+def _artifacts(value):
+    """Artifacts from the JSON (or the mapping) a rule passes: one, a list, or a mapping of them."""
+    value = json.loads(value) if isinstance(value, str) else value
+    if isinstance(value, Artifact):
+        return value
+    if isinstance(value, dict) and "path" in value:
+        return Artifact.from_dict(value)
+    if isinstance(value, list):
+        return [_artifacts(item) for item in value]
+    return {key: _artifacts(item) for key, item in value.items()}
 
 
 def _plugin_recording(record, outputs, plugin, params, run_id, **extra):
@@ -134,7 +141,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache=""):
 
         params = parse_params(mesh.MeshParams, json.loads(params_json), owner="mesh")
         as_dict = params_to_dict(params)
-        with recording(record, [("output", output)], run_id=mesh.mesh_id(params), kind="mesh", plugin="mesh",
+        with recording(record, [("output", output, "mesh")], run_id=mesh.mesh_id(params), kind="mesh", plugin="mesh",
                        plugin_version=str(mesh.MESH_FORMAT),
                        code_hash=code_hash(mesh.write_mesh.__module__), params=as_dict):
             print(f"mesh {json.dumps(as_dict, sort_keys=True)} -> {output}")
@@ -152,8 +159,9 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         Its parameters as JSON (defaults may be missing; they are filled).
     output, record, log : str or pathlib.Path
         Simulation file (HDF5), its provenance record, the log.
-    inputs : Mapping[str, str]
-        Upstream files by declared category (e.g. ``{"mesh": path}``).
+    inputs : str or Mapping
+        Upstream files by consumed format, as artifacts (``{"mesh": Artifact}``), or
+        their JSON (:meth:`stickslip.study.Study.dumps`).
     threads : int
         Threads of the parallel kernels.
     numba_cache : {"", "job"}
@@ -164,17 +172,18 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         from .numba_options import set_num_threads
 
         plugin, params = _load("solver", solver, params_json)
+        inputs = _artifacts(inputs)
         for role, path in inputs.items():
             _check_hdf5(role, path)
         used = set_num_threads(threads)
-        with _plugin_recording(record, [("output", output)], plugin, params, registry.run_id(plugin, params),
-                               threads=used, inputs=sorted(inputs.items())) as job:
+        with _plugin_recording(record, [("output", output, plugin.produces)], plugin, params,
+                               registry.run_id(plugin, params), threads=used, inputs=sorted(inputs.items())) as job:
             print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(job['params'])}")
             partial = partial_path(output)
             partial.parent.mkdir(parents=True, exist_ok=True)
             if partial.exists():
                 print(f"resuming from {partial}")
-            plugin.run(params, partial, threads=used, inputs={k: Path(v) for k, v in inputs.items()})
+            plugin.run(params, partial, threads=used, inputs={k: v.path for k, v in inputs.items()})
             os.replace(partial, output)
 
 
@@ -200,7 +209,7 @@ def partial_path(output):
     return output.parent / "partial" / output.name
 
 
-def run_analysis(analysis, params_json, input, output, record, log, *, numba_cache=""):
+def run_analysis(analysis, params_json, simulation, output, record, log, *, numba_cache=""):
     """Run one analysis on one simulation output.
 
     Parameters
@@ -209,8 +218,8 @@ def run_analysis(analysis, params_json, input, output, record, log, *, numba_cac
         Analysis plugin name.
     params_json : str
         Its parameters as JSON.
-    input : str or pathlib.Path
-        The simulation file.
+    simulation : str
+        The simulation file as an artifact, JSON (path, run id, solver, format).
     output, record, log : str or pathlib.Path
         Table file (HDF5), its provenance record, the log.
     numba_cache : {"", "job"}
@@ -219,12 +228,17 @@ def run_analysis(analysis, params_json, input, output, record, log, *, numba_cac
     prepare_environment(1, numba_cache)
     with _logged(log):
         plugin, params = _load("analysis", analysis, params_json)
-        _check_hdf5("simulation", input)
-        role = f"solver:{Path(input).parent.name}"
-        with _plugin_recording(record, [("output", output)], plugin, params,
-                               _derived_run_id(plugin, params, [input]), inputs=[(role, input)]):
-            print(f"analysis {plugin.name} {plugin.version} on {input}")
-            plugin.run(params, Path(input), Path(output))
+        simulation = _artifacts(simulation)
+        if simulation.format not in plugin.consumes:
+            raise FileFormatError(f"{simulation}: a {simulation.format} file; analysis {analysis!r} reads "
+                                  f"{', '.join(plugin.consumes)}")
+        _check_hdf5("simulation", simulation)
+        with _plugin_recording(record, [("output", output, plugin.produces)], plugin, params,
+                               registry.derived_run_id(plugin, params, [simulation.run_id]),
+                               inputs=[("simulation", simulation)]):
+            print(f"analysis {plugin.name} {plugin.version} on {simulation} ({simulation.plugin} "
+                  f"{simulation.run_id})")
+            plugin.run(params, simulation, Path(output))
 
 
 def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_cache=""):
@@ -237,7 +251,8 @@ def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_c
     params_json : str
         Its parameters as JSON.
     inputs_json : str
-        JSON object: input category -> list of paths.
+        JSON object: input category -> list of artifacts (an analysis output with its
+        simulation as ``parent``).
     output, record, log : str or pathlib.Path
         The PDF (the PNG goes beside it), the provenance record, the log.
     numba_cache : {"", "job"}
@@ -246,16 +261,18 @@ def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_c
     prepare_environment(1, numba_cache)
     with _logged(log):
         plugin, params = _load("figure", figure, params_json)
-        inputs = json.loads(inputs_json)
-        files = [(category, path) for category, paths in sorted(inputs.items()) for path in paths]
+        inputs = _artifacts(inputs_json)
+        files = [(category, item) for category, items in sorted(inputs.items()) for item in items]
+        parents = {item.parent.run_id: item.parent for _, item in files if item.parent is not None}
+        files += [("simulation", parents[key]) for key in sorted(parents)]
         for role, path in files:
             _check_hdf5(role, path)
         output = Path(output)
         outputs = [("pdf", output), ("png", output.with_suffix(".png"))]
-        with _plugin_recording(record, outputs, plugin, params,
-                               _derived_run_id(plugin, params, [p for _, p in files]), inputs=files):
+        run_id = registry.derived_run_id(plugin, params, [item.run_id for items in inputs.values() for item in items])
+        with _plugin_recording(record, outputs, plugin, params, run_id, inputs=files):
             print(f"figure {plugin.name} {plugin.version} from {len(files)} file(s)")
-            plugin.run(params, {k: [Path(p) for p in v] for k, v in inputs.items()}, output)
+            plugin.run(params, inputs, output)
 
 
 def build_database(records, database, log):

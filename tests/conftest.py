@@ -8,12 +8,16 @@ from pathlib import Path
 import pytest
 
 from stickslip import registry
+from stickslip.lineage import Artifact
+from stickslip.study import Study
 
 REPO = Path(__file__).resolve().parent.parent
 TOY = Path(__file__).resolve().parent / "toy_plugin" / "stickslip_toy.py"
+TWIN = Path(__file__).resolve().parent / "toy_plugin" / "stickslip_femtwin.py"
 
 ENTRY_POINTS = """[stickslip.solvers]
 toy = stickslip_toy
+fem-twin = stickslip_femtwin
 
 [stickslip.analyses]
 toy = stickslip_toy
@@ -25,13 +29,14 @@ toy = stickslip_toy
 
 @pytest.fixture(scope="session")
 def toy_distribution(tmp_path_factory):
-    """A directory holding the toy plugin module and its installed-distribution metadata.
+    """A directory holding the toy plugin modules and their installed-distribution metadata.
 
     Put it on ``sys.path`` (or ``PYTHONPATH``) and the entry points make
     ``stickslip`` find the ``toy-*`` plugins, as for a ``pip install``-ed package.
     """
     root = tmp_path_factory.mktemp("site")
     shutil.copy(TOY, root / TOY.name)
+    shutil.copy(TWIN, root / TWIN.name)
     info = root / "stickslip_toy-0.1.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: stickslip-toy\nVersion: 0.1\n")
@@ -76,22 +81,22 @@ def toy_results(tmp_path, toy_plugins, monkeypatch):
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("NUMBA_NUM_THREADS", "1")
-    records, sims, events = [], [], []
-    solver = registry.get("solver", "toy-spring-block")
+    records, events = [], []
+    solver, analysis = registry.get("solver", "toy-spring-block"), registry.get("analysis", "toy-slips")
     for seed in (1, 2):
         values = {"seed": seed, "slips": 4}
         run = registry.run_id(solver, parse_params(solver.params, values))
-        sim = f"results/default/sim/toy-spring-block/{run}.h5"
-        run_simulation("toy-spring-block", json.dumps(values), sim, sim.replace(".h5", ".provenance.json"),
+        sim = Artifact(f"results/default/sim/toy-spring-block/{run}.h5", run, solver.name, solver.produces)
+        run_simulation("toy-spring-block", json.dumps(values), sim.path, sim.path.with_suffix(".provenance.json"),
                        f"results/default/logs/{run}.log", inputs={}, threads=1)
-        event = f"results/default/events/toy-slips/toy-spring-block/{run}.h5"
-        run_analysis("toy-slips", "{}", sim, event, event.replace(".h5", ".provenance.json"),
+        event = Artifact(f"results/default/events/toy-slips/toy-spring-block/{run}.h5",
+                         registry.derived_run_id(analysis, analysis.params(), [run]), analysis.name,
+                         analysis.produces, sim)
+        run_analysis("toy-slips", "{}", Study.dumps(sim), event.path, event.path.with_suffix(".provenance.json"),
                      f"results/default/logs/e{run}.log")
-        sims.append(sim)
         events.append(event)
-        records += [Path(sim.replace(".h5", ".provenance.json")), Path(event.replace(".h5", ".provenance.json"))]
-    inputs = {"solver:toy-spring-block": sims, "analysis:toy-slips": events}
-    run_figure("toy-force", "{}", json.dumps(inputs), "results/default/figures/toy-force.pdf",
+        records += [sim.path.with_suffix(".provenance.json"), event.path.with_suffix(".provenance.json")]
+    run_figure("toy-force", "{}", Study.dumps({"analysis:toy-slips": events}), "results/default/figures/toy-force.pdf",
                "results/default/figures/toy-force.provenance.json", "results/default/logs/figure.log")
     records.append(Path("results/default/figures/toy-force.provenance.json"))
     return records

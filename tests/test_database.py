@@ -8,7 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stickslip.h5io import FileFormatError, open_file, read_table
+from stickslip.formats.event_table import read_slip_events
+from stickslip.h5io import FileFormatError
+from stickslip.lineage import Artifact
+from stickslip.params import parse_params
 from stickslip.provenance import ingest as ingest_module
 from stickslip.provenance import query
 from stickslip.provenance.database import SCHEMA_VERSION
@@ -36,12 +39,18 @@ def test_ingest_fills_every_table_from_records(toy_results):
     # events: the slips of the table, one per slip, each equal to the file's values
     run = query.runs(database, kind="solver", seed=1)["run_id"].iloc[0]
     events = query.events(database, run_id=run)
-    with open_file(f"results/default/events/toy-slips/toy-spring-block/{run}.h5") as handle:
-        slips = read_table(handle, "slips")
-    np.testing.assert_array_equal(events["slip"].to_numpy(), slips["dR"].to_numpy())
-    np.testing.assert_array_equal(events["time"].to_numpy(), slips["t"].to_numpy())
+    slips = read_slip_events(f"results/default/events/toy-slips/toy-spring-block/{run}.h5")
+    np.testing.assert_array_equal(events["slip"].to_numpy(), slips["slip"].to_numpy())
+    np.testing.assert_array_equal(events["time"].to_numpy(), slips["time"].to_numpy())
     assert set(events["seed"]) == {1} and set(events["interface"]) == {1}
-    assert set(events["source"]) == {"numerical"}  # the toy file is not in the lab time-series format
+    assert set(events["source"]) == {"numerical"}  # the source the toy-block format declares
+    assert pd.isna(events["increment"]).all()  # a column the table leaves out is NULL
+    # lineage: the figure's inputs name the runs that made them
+    made_by = query.sql("SELECT role, made_by FROM artifacts AS a JOIN runs AS r ON r.run_id = a.run_id "
+                        "WHERE r.kind = 'figure' AND a.direction = 'input' ORDER BY role, made_by", database)
+    analyses = query.runs(database, kind="analysis")["run_id"]
+    assert list(made_by["role"]) == ["analysis:toy-slips"] * 2 + ["simulation"] * 2
+    assert set(made_by["made_by"][:2]) == set(analyses) and set(made_by["made_by"][2:]) == set(sims["run_id"])
     assert list(query.figures(database)["figure"]) == ["toy-force"]
     assert query.sql("SELECT value FROM schema_info WHERE key = 'schema_version'", database).iloc[0, 0] == str(
         SCHEMA_VERSION)
@@ -115,25 +124,25 @@ def test_queries_are_read_only_and_filter(toy_results):
         query.runs("results/missing.sqlite")
 
 
-def test_simulation_columns_fall_back_to_file_attributes(tmp_path):
-    sim = tmp_path / "0123456789abcdef.h5"
-    with open_file(sim, "w") as handle:
-        handle.attrs.update({"n_interfaces": 3, "regime": "compliant", "k_drive": 1e-6, "phi": 3.4e-11})
-    record = {"run_id": "0123456789abcdef", "plugin": "fem", "params": {"plates": 4, "N": 9, "seed": 2,
-                                                                        "k_drive": 1e-6},
-              "outputs": [{"path": "results/default/sim/fem/0123456789abcdef.h5"}]}
-    row = ingest_module._simulation_row(record, tmp_path / "0123456789abcdef.provenance.json")
-    assert row == {"run_id": "0123456789abcdef", "solver": "fem", "path": "results/default/sim/fem/0123456789abcdef.h5",
-                   "source": "numerical", "protocol": None, "n": 3, "a": None, "plates": 4, "blocks": 9,
-                   "k_drive": 1e-6, "phi": 3.4e-11, "regime": "compliant", "seed": 2}
+def test_ingest_reads_lineage_and_formats_not_paths(tmp_path, toy_plugins, monkeypatch):
+    """Files under arbitrary names: events are keyed by the run id the lineage carries."""
+    from stickslip import registry
+    from stickslip.study import Study
+    from stickslip.workflow_api import run_analysis, run_simulation
 
-
-def test_regime_stated_by_an_analysis_fills_its_simulation(toy_results):
-    record = read_record(toy_results[1])  # the analysis of the seed-1 run
-    with open_file(record["outputs"][0]["path"], "r+") as handle:
-        handle.attrs["regime"] = "compliant"
-    ingest("results/default/stickslip.sqlite", toy_results)
-    runs = query.runs("results/default/stickslip.sqlite", kind="solver")
-    regimes = dict(zip(runs["seed"], runs["regime"]))
-    assert regimes[1] == "compliant" and pd.isna(regimes[2])
-    assert len(query.events("results/default/stickslip.sqlite", regime="compliant")) == 4
+    monkeypatch.chdir(tmp_path)
+    solver, analysis = registry.get("solver", "toy-spring-block"), registry.get("analysis", "toy-slips")
+    run = registry.run_id(solver, parse_params(solver.params, {"seed": 3, "slips": 3}))
+    sim = Artifact("anything/first.h5", run, solver.name, solver.produces)
+    run_simulation(solver.name, '{"seed": 3, "slips": 3}', sim.path, "anything/first.provenance.json", "log1",
+                   inputs={}, threads=1)
+    run_analysis(analysis.name, "{}", Study.dumps(sim), "elsewhere/slips.h5", "elsewhere/slips.provenance.json",
+                 "log2")
+    ingest("db.sqlite", ["anything/first.provenance.json", "elsewhere/slips.provenance.json"])
+    events = query.events("db.sqlite")
+    assert list(query.runs("db.sqlite", kind="solver")["run_id"]) == [run]
+    assert len(events) == 3 and set(events["simulation_run_id"]) == {run} and set(events["seed"]) == {3}
+    assert set(events["solver"]) == {"toy-spring-block"}
+    with pytest.raises(FileFormatError, match="a fem-run file; analysis 'toy-slips' reads toy-block"):
+        wrong = Artifact("anything/first.h5", run, "fem", "fem-run")
+        run_analysis(analysis.name, "{}", Study.dumps(wrong), "x.h5", "x.provenance.json", "log3")

@@ -5,7 +5,9 @@ import pytest
 
 from stickslip import registry
 from stickslip.events import extraction, plugin, results
+from stickslip.formats.event_table import read_slip_events
 from stickslip.h5io import FileFormatError
+from stickslip.hashing import sha256_file
 from test_events_extraction import EVENTS, N, history
 
 RUN_ATTRS = {"N": N, "plates": 3, "n_interfaces": 2, "k_drive": 1e-6, "seed": 4, "eps0": 5e-5, "c_s": 0.7071}
@@ -14,13 +16,14 @@ STIFF = 1e-3 * (1458 / N) ** 2  # the paper's stiff driving, for N blocks
 
 def write(path, events=EVENTS, attrs=RUN_ATTRS):
     tables = plugin.event_tables(history(N, events), N)
-    plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path)
+    # synthetic tables: the header's input checksum is that of this test module
+    plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path, input=__file__)
     return tables
 
 
 def test_event_file_round_trip(tmp_path):
     tables = write(tmp_path / "events.h5")
-    read = results.read_analysis_file(tmp_path / "events.h5", ("increments", "slips", "slip_interfaces", "sequences"))
+    read = results.read_analysis_file(tmp_path / "events.h5", tuple(tables))
     assert read.n == 2 and read.regime == "compliant"
     assert read.attrs["N"] == N and read.attrs["seed"] == 4 and read.attrs["steady_state"] == 8
     assert read.attrs["analysis"] == "numerical-events"
@@ -33,6 +36,21 @@ def test_event_file_round_trip(tmp_path):
             else:
                 assert got.tolist() == expected.tolist()
     np.testing.assert_allclose(extraction.slip_fractions(read.tables["slips"], 2), [4 / 7, 3 / 7])
+    assert read.attrs["format"] == "event-table" and read.attrs["input_sha256"] == sha256_file(__file__)
+
+
+def test_slip_events_are_the_per_interface_slips_numbered_by_event(tmp_path):
+    tables = write(tmp_path / "events.h5")
+    table = read_slip_events(tmp_path / "events.h5")
+    per = tables["slip_interfaces"]
+    assert list(table.columns) == ["event", "interface", "multi", "dmu", "increment", "dgamma"]
+    np.testing.assert_array_equal(table["interface"], per["a"])
+    np.testing.assert_array_equal(table["dmu"], per["dmu"])
+    np.testing.assert_array_equal(table["multi"], ~per["single"].to_numpy(dtype=bool))
+    # one event number per slipping increment, counted from 0 in increment order
+    assert table.groupby("event")["increment"].nunique().eq(1).all()
+    assert table["event"].tolist() == table["increment"].rank(method="dense").astype(int).sub(1).tolist()
+    assert table["event"].max() + 1 == len(tables["slips"])
 
 
 def test_same_input_same_bytes(tmp_path):
@@ -67,5 +85,5 @@ def test_grouping_by_regime_and_n(tmp_path):
 
 def test_plugin_is_registered():
     found = registry.get("analysis", "numerical-events")
-    assert found.inputs == ("fem",)
+    assert (found.consumes, found.produces) == (("fem-run",), "event-table")
     assert found.version == plugin.VERSION

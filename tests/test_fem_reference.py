@@ -10,7 +10,9 @@ import pytest
 
 from stickslip import registry
 from stickslip.cli import main
-from stickslip.fem.output import read_increments, read_run_attrs, rerun_with_failures
+from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.fem.replay import EventReplay
+from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
@@ -81,7 +83,7 @@ def test_rerun_records_every_block_failure_of_an_event(reference_run):
     table = read_increments(reference_run)
     kicks = table[table["kick"] & (table["A_a1"] > 3)]
     increment = int(kicks["increment"].iloc[0])
-    events = rerun_with_failures(reference_run, increment)  # asserts it reproduces the stored increment
+    events = EventReplay(reference_run).failures(increment)  # asserts it reproduces the stored increment
     assert list(events.columns) == ["a", "block", "t", "direction"]
     assert events["direction"].sum() == table["S_a1"][increment]
     before, after = _indices(reference_run, increment)
@@ -89,6 +91,18 @@ def test_rerun_records_every_block_failure_of_an_event(reference_run):
     assert changed <= set(events["block"])
     assert events["t"].is_monotonic_increasing and events["t"].iloc[0] >= 0.0
     assert set(events["a"]) == {1}
+
+
+def test_one_replay_serves_every_event_of_a_run(reference_run):
+    """The model is built once per run file: replaying events in turn gives what fresh replays give."""
+    table = read_increments(reference_run)
+    increments = table["increment"][table["kick"] & (table["A_a1"] > 0)].to_numpy()[:3]
+    shared = EventReplay(reference_run)
+    for increment in increments[::-1]:  # out of order: each replay restores its own state
+        pd.testing.assert_frame_equal(shared.failures(int(increment)),
+                                      EventReplay(reference_run).failures(int(increment)))
+    with pytest.raises(FileFormatError, match="not a stored kick increment"):
+        shared.failures(int(table["increment"][~table["kick"]].iloc[1]))
 
 
 def _indices(path, increment):

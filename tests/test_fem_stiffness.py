@@ -5,7 +5,7 @@ import math
 import pytest
 
 from stickslip import registry
-from stickslip.fem.output import read_run_attrs
+from stickslip.fem.output import describe, read_run_attrs
 from stickslip.fem.stiffness import PHI_STIFF, at_paper_phi, driving_regime, stiffness_ratio
 from stickslip.mesh.rows import plate_target_height
 from stickslip.params import parse_params
@@ -45,3 +45,5 @@ def test_the_run_file_states_phi_and_regime(tmp_path):
     attrs = read_run_attrs(tmp_path / "run.h5")
     assert attrs["phi"] == stiffness_ratio(2.0, 9) == pytest.approx(2.0 / 2 * (3 / 364) ** 2)
     assert attrs["regime"] == "stiff"
+    described = describe(tmp_path / "run.h5")  # the database's simulation columns
+    assert (described["phi"], described["regime"]) == (attrs["phi"], "stiff")

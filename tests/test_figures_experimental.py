@@ -1,13 +1,16 @@
 """Experimental figures: densities, run matching, and every figure drawn from a small virtual study."""
 
+import dataclasses
+
 import numpy as np
 import pandas as pd
 import pytest
 
 from stickslip import registry
+from stickslip.experiment.timeseries import read_timeseries
 from stickslip.figures import experimental_data, plotting
-from stickslip.figures.experimental_panels import linear_edges, log_edges
 from stickslip.h5io import FileFormatError
+from stickslip.lineage import Artifact
 from stickslip.params import parse_params
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distributions", "figS-aging-variations",
@@ -17,7 +20,7 @@ FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distrib
 def test_density_is_normalised_on_linear_and_logarithmic_bins():
     rng = np.random.default_rng(0)
     values = rng.lognormal(3.0, 1.0, 5000)
-    for edges in (linear_edges(values, 40), log_edges(values, 10)):
+    for edges in (plotting.linear_edges(values, 40), plotting.log_edges(values, 10)):
         centres, pdf = plotting.density(values, edges)
         inside = np.count_nonzero((values >= edges[0]) & (values <= edges[-1])) / values.size
         assert np.nansum(pdf * np.diff(edges)) == pytest.approx(inside)
@@ -34,24 +37,30 @@ def study(tmp_path_factory):
     solver, analysis = registry.get("solver", "lever"), registry.get("analysis", "experiment-events")
     runs = [{"n": n, "seed": n} for n in range(1, 6)]
     runs += [{"protocol": "individual", "a": a, "seed": 10 + a} for a in range(1, 5)]
-    inputs = {experimental_data.LEVER: [], experimental_data.EVENTS: []}
+    inputs = {experimental_data.EVENTS: []}
     for index, values in enumerate(runs):
-        raw, events = root / f"raw{index}.h5", root / f"events{index}.h5"
-        solver.run(parse_params(solver.params, {**values, "duration": 2500.0}), raw, threads=1, inputs={})
-        analysis.run(parse_params(analysis.params, {}), raw, events)
-        inputs[experimental_data.LEVER].append(raw)
+        params = parse_params(solver.params, {**values, "duration": 2500.0})
+        raw = Artifact(root / f"raw{index}.h5", registry.run_id(solver, params), solver.name, solver.produces)
+        solver.run(params, raw.path, threads=1, inputs={})
+        events = Artifact(root / f"events{index}.h5", registry.derived_run_id(analysis, analysis.params(), [raw.run_id]),
+                          analysis.name, analysis.produces, raw)
+        analysis.run(parse_params(analysis.params, {}), raw, events.path)
         inputs[experimental_data.EVENTS].append(events)
     return inputs
 
 
-def test_example_run_is_matched_by_content(study):
-    slips = experimental_data.load_slips(study[experimental_data.EVENTS])
+def test_example_run_is_the_events_file_parent(study):
+    events = study[experimental_data.EVENTS]
+    slips = experimental_data.load_slips(events)
     assert set(slips["n"]) == {1, 2, 3, 4, 5} and set(slips["protocol"]) == {"stack", "individual"}
-    record, run_slips = experimental_data.example_run(slips, study[experimental_data.LEVER], n=4)
+    record, run_slips = experimental_data.example_run(slips, events, n=4)
     assert record.n == 4 and record.protocol == "stack"
     assert set(run_slips["n"]) == {4} and run_slips["file"].nunique() == 1
-    with pytest.raises(FileFormatError, match="none of the solver:lever inputs"):
-        experimental_data.example_run(slips, study[experimental_data.LEVER][:3], n=4)
+    chosen = next(item for item in events if str(item) == run_slips["file"].iloc[0])
+    np.testing.assert_array_equal(record.F, read_timeseries(chosen.parent).F)
+    orphans = [dataclasses.replace(item, parent=None) for item in events]
+    with pytest.raises(FileFormatError, match="without the time series it was made from"):
+        experimental_data.example_run(slips, orphans, n=4)
 
 
 @pytest.mark.slow

@@ -52,7 +52,7 @@ def study(tmp_path_factory):
             attrs = {"N": N, "plates": n + 1, "k_drive": K_DRIVE[regime], "seed": 0, "c_s": C_S, "h": H_BLOCK}
             tables = plugin.event_tables(history(N, random_events(n, regime, rng), load_gamma=0.7), N)
             path = root / f"events-{regime}-{n}.h5"
-            plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path)
+            plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path, input=__file__)
             event_files.append(path)
             if n != 2:
                 continue
@@ -66,7 +66,7 @@ def study(tmp_path_factory):
                                                   spacing=SPACING, params=params)
             path = root / f"fronts-{regime}.h5"
             fronts.write_front_file(failures, table, {**plugin.event_attrs(attrs, tables["increments"]),
-                                                      "interface_spacing": SPACING}, path)
+                                                      "interface_spacing": SPACING}, path, input=__file__)
             front_files.append(path)
     return {"analysis:numerical-events": event_files, "analysis:front-dynamics": front_files}
 

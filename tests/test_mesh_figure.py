@@ -30,8 +30,8 @@ def test_selects_the_mesh_by_plates_and_N(meshes):
 
 def test_plugin_writes_pdf_and_png(meshes, tmp_path):
     plugin = registry.get("figure", "figS-mesh")
-    assert plugin.inputs == ("mesh",)
+    assert plugin.inputs == ("format:mesh",)
     params = parse_params(plugin.params, {"plates": 3, "zoom_width": 20})
     output = tmp_path / "figS-mesh.pdf"
-    plugin.run(params, {"mesh": list(meshes.values())}, output)
+    plugin.run(params, {"format:mesh": list(meshes.values())}, output)
     assert output.stat().st_size > 0 and output.with_suffix(".png").stat().st_size > 0

@@ -8,7 +8,8 @@ import pytest
 
 from stickslip.h5io import FileFormatError
 from stickslip.provenance import code
-from stickslip.provenance.record import (REQUIRED_FIELDS, read_record, record_path, recording, sha256_file,
+from stickslip.hashing import sha256_file
+from stickslip.provenance.record import (REQUIRED_FIELDS, read_record, record_path, recording,
                                          write_record)
 
 

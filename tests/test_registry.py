@@ -17,7 +17,7 @@ def test_malformed_plugins_are_refused():
     with pytest.raises(registry.PluginError, match="path component"):
         registry.register("solver", "Bad Name", "1", Params)(lambda params, output, *, threads, inputs: None)
     with pytest.raises(registry.PluginError, match="signature"):
-        registry.register("solver", "test-wrong-signature", "1", Params)(lambda params, out: None)
+        registry.register("solver", "test-wrong-signature", "1", Params, produces="fem-run")(lambda params, out: None)
     with pytest.raises(registry.PluginError, match="dataclass"):
         registry.register("analysis", "test-no-dataclass", "1", dict)(lambda params, input, output: None)
 
@@ -33,7 +33,7 @@ def test_register_get_and_run_id():
     def solve(params, output, *, threads, inputs):
         """Test solver."""
 
-    registry.register("solver", "test-solver", "1.0", Params)(solve)
+    registry.register("solver", "test-solver", "1.0", Params, produces="fem-run")(solve)
     plugin = registry.get("solver", "test-solver")
     assert plugin.summary == "Test solver."
     assert "test-solver" in registry.available("solver")
@@ -41,6 +41,41 @@ def test_register_get_and_run_id():
     assert a == registry.run_id(plugin, parse_params(Params, {}))  # defaults filled: same id
     assert a != registry.run_id(plugin, parse_params(Params, {"x": 2}))
     with pytest.raises(registry.PluginError, match="already registered"):
-        registry.register("solver", "test-solver", "1.0", Params)(lambda params, output, *, threads, inputs: None)
+        registry.register("solver", "test-solver", "1.0", Params, produces="fem-run")(
+            lambda params, output, *, threads, inputs: None)
     with pytest.raises(registry.PluginError, match="unknown solver 'nope'"):
         registry.get("solver", "nope")
+
+
+def _analysis(params, input, output):
+    """Test analysis."""
+
+
+@pytest.mark.parametrize("contract, message", [
+    ({}, "declare the format it produces"),
+    ({"produces": "event-table"}, "declare the one format it consumes"),
+    ({"consumes": ("no-such-format",), "produces": "event-table"}, "unknown format 'no-such-format'"),
+    ({"consumes": ("fem-run",), "produces": "event-table", "inputs": ("analysis:x",)}, "only figures declare inputs"),
+    ({"consumes": ("fem-run",), "produces": "event-table", "replay": print}, "replay must be a callable of a solver"),
+])
+def test_plugins_declare_the_formats_they_consume_and_produce(contract, message):
+    with pytest.raises(registry.PluginError, match=message):
+        registry.register("analysis", "test-contract", "1", Params, **contract)(_analysis)
+
+
+def test_figure_inputs_are_analyses_or_formats():
+    with pytest.raises(registry.PluginError, match="expected 'analysis:<name>' or 'format:<name>'"):
+        registry.register("figure", "test-figure-inputs", "1", Params, inputs=("solver:fem",))(
+            lambda params, inputs, output: None)
+
+
+def test_derived_run_ids_follow_the_lineage():
+    registry.register("analysis", "test-derived", "1", Params, consumes=("fem-run",), produces="event-table")(
+        _analysis)
+    plugin = registry.get("analysis", "test-derived")
+    params = parse_params(Params, {})
+    a = registry.derived_run_id(plugin, params, ["0123456789abcdef", "fedcba9876543210"])
+    assert a == registry.derived_run_id(plugin, params, ["fedcba9876543210", "0123456789abcdef"])
+    assert a != registry.derived_run_id(plugin, params, ["0123456789abcdef"])
+    assert a != registry.derived_run_id(plugin, parse_params(Params, {"x": 2}), ["0123456789abcdef",
+                                                                                 "fedcba9876543210"])

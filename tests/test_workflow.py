@@ -35,7 +35,7 @@ TOY_CONFIG = {
 
 def test_entry_point_plugins_are_discovered(toy_plugins):
     assert registry.get("solver", "toy-spring-block").module == "stickslip_toy"
-    assert registry.get("analysis", "toy-slips").inputs == ("toy-spring-block",)
+    assert registry.get("analysis", "toy-slips").consumes == ("toy-block",)
     assert "toy-force" in registry.available("figure")
 
 
@@ -60,8 +60,10 @@ def test_study_expands_grids_and_resolves_inputs(toy_plugins):
     assert len(study.analysis_jobs) == 3
     figure = study.figures["toy-force"]
     assert figure.params == {"width": 5.0}
-    assert figure.inputs["solver:toy-spring-block"] == sorted(sim.path for sim in study.simulations)
-    assert len(figure.inputs["analysis:toy-slips"]) == 3
+    pairs = {(item.path.as_posix(), item.parent.path.as_posix()) for item in figure.inputs["analysis:toy-slips"]}
+    assert pairs == {(job.path, job.simulation.path) for job in study.analysis_jobs}
+    assert figure.files() == sorted(job.path for job in study.analysis_jobs) + sorted(sim.path for sim in
+                                                                                    study.simulations)
     assert len(study.records()) == 3 + 3 + 1
     sim = study.simulations[0]
     assert study.name == "default" and sim.path == f"results/default/sim/toy-spring-block/{sim.run_id}.h5"
@@ -74,7 +76,8 @@ def test_study_expands_grids_and_resolves_inputs(toy_plugins):
      r"config solvers.toy-spring-block\[1\]: parameter 'F_d': must be below"),
     (lambda c: c["solvers"].update(nope=[]), r"config solvers.nope: unknown solver 'nope'"),
     (lambda c: c["figures"].update({"toy-force": {"height": 1}}), r"config figures.toy-force: unknown parameter"),
-    (lambda c: c["solvers"].pop("toy-spring-block"), r"config analyses.toy-slips: it reads outputs"),
+    (lambda c: c["solvers"].pop("toy-spring-block"),
+     r"config analyses.toy-slips: it reads toy-block files, which no solver of the study produces"),
 ])
 def test_study_errors_name_the_config_key(toy_plugins, change, message):
     config = copy.deepcopy(TOY_CONFIG)
@@ -255,12 +258,12 @@ def test_solvers_that_read_a_mesh_share_one_mesh_job():
     def solve(params, output, *, threads, inputs):
         """Test solver reading a mesh."""
 
-    registry.register("solver", "test-meshed", "1", MeshedParams, inputs=("mesh",))(solve)
+    registry.register("solver", "test-meshed", "1", MeshedParams, consumes=("mesh",), produces="fem-run")(solve)
     study = Study({"solvers": {"test-meshed": [{"params": {}, "grid": {"seed": [1, 2]}},
                                                {"params": {"N": 27}, "grid": {}}]}})
     expected = {mesh.mesh_id(parse_params(mesh.MeshParams, {"N": N, "plates": 3})): N for N in (9, 27)}
     assert {key: value["N"] for key, value in study.meshes.items()} == expected
-    inputs = [study.solver_inputs(sim.solver, sim.run_id)["mesh"] for sim in study.simulations]
+    inputs = [study.solver_inputs(sim.solver, sim.run_id)["mesh"].path.as_posix() for sim in study.simulations]
     assert sorted(set(inputs)) == sorted(f"results/default/mesh/{key}.h5" for key in expected)
     assert len(study.records()) == 2 + 3
 

@@ -22,7 +22,7 @@ class Interrupted(Exception):
     """Stands for the wall-time kill of a cluster job."""
 
 
-@registry.register("solver", "test-resumable", "1", StepsParams)
+@registry.register("solver", "test-resumable", "1", StepsParams, produces="fem-run")
 def _resumable(params, output, *, threads, inputs):
     """Stores one row per step as it goes and resumes from what an earlier call stored."""
     mode = "r+" if output.exists() else "w"

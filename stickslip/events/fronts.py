@@ -1,6 +1,7 @@
 """Time-resolved multi-slip events: rupture-front velocity and the delay between interfaces.
 
-A stored kick increment of a ``fem`` run is re-run while every block failure is recorded
+A stored kick increment of a ``fem-run`` file is replayed by the solver that wrote it (its
+``replay`` capability, :mod:`stickslip.fem.replay` for ``fem``) while every block failure is recorded
 (interface ``a``, ``block``, time ``t`` since the kick, ``direction``), as the paper does
 for its event maps (appendix "Front dynamics -- numerics"). From the failures of one event:
 
@@ -24,8 +25,10 @@ import dataclasses
 import numpy as np
 import pandas as pd
 
-from .. import h5io
+from .. import h5io, registry
+from ..formats.analysis_file import write_analysis_file
 from ..h5io import FileFormatError
+from ..lineage import Artifact
 from ..mesh import load_mesh
 from ..params import ParameterError, param
 from ..progress import iterate
@@ -36,6 +39,7 @@ from .plugin import event_attrs
 __all__ = ["FrontParams", "VERSION", "slipping_interfaces", "front_fit", "analyse_event", "multi_slip_increments",
            "interface_spacing", "front_tables", "write_front_file", "run"]
 
+NAME = "front-dynamics"
 VERSION = "1"
 
 FAILURE_COLUMNS = ("a", "block", "t", "direction")
@@ -180,22 +184,22 @@ def multi_slip_increments(classified, max_events, kinds=("multi",)):
     return classified["increment"].to_numpy()[chosen][:max_events]
 
 
-def interface_spacing(layer_heights):
+def interface_spacing(interface_heights):
     """Distance H between the mid-lines of adjacent interfaces.
 
     Parameters
     ----------
-    layer_heights : array_like
-        Mid-height of every layer l = 0 ... 2n (l = 2i plate i, l = 2a - 1 interface a),
-        shape [2n + 1] [FE length].
+    interface_heights : array_like
+        Mid-height of every interface a = 1 ... n, shape [n] [FE length] (the run's layer
+        heights at :func:`stickslip.fem.output.interface_layers`).
 
     Returns
     -------
     float
-        ``layer_heights[3] - layer_heights[1]`` [FE length]; NaN with a single interface.
+        ``interface_heights[1] - interface_heights[0]`` [FE length]; NaN with a single interface.
     """
-    heights = np.asarray(layer_heights, dtype=float)
-    return float(heights[3] - heights[1]) if heights.size >= 4 else np.nan
+    heights = np.asarray(interface_heights, dtype=float)
+    return float(heights[1] - heights[0]) if heights.size >= 2 else np.nan
 
 
 @dataclasses.dataclass(frozen=True)
@@ -256,7 +260,7 @@ def front_tables(classified, rerun, *, N, h, c_s, spacing, params):
     return failure_table[list(FAILURE_DTYPES)].astype(FAILURE_DTYPES), front_table.astype(FRONT_DTYPES)
 
 
-def write_front_file(failures, fronts, attrs, output):
+def write_front_file(failures, fronts, attrs, output, *, input, params=FrontParams()):
     """Write the tables ``failures`` and ``fronts`` and the attributes to ``output`` (atomically).
 
     Parameters
@@ -267,28 +271,41 @@ def write_front_file(failures, fronts, attrs, output):
         Run attributes as :func:`stickslip.events.plugin.event_attrs` gives them, plus
         ``interface_spacing`` [FE length].
     output : str or pathlib.Path
+    input : str or os.PathLike
+        The analysed run file (its checksum goes into the header).
+    params : FrontParams, optional
     """
-    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
-        h5io.write_attrs(file, {**attrs, "analysis": "front-dynamics", "analysis_version": VERSION})
-        h5io.write_table(file, "failures", failures)
-        h5io.write_table(file, "fronts", fronts)
+    write_analysis_file(output, "front-table", analysis=NAME, version=VERSION, params=params, input=input,
+                        attrs=attrs, tables={"failures": failures, "fronts": fronts})
 
 
-@register("analysis", "front-dynamics", VERSION, FrontParams, inputs=("fem",))
+def _replay(input):
+    """The replay of the solver that wrote ``input`` (from its lineage)."""
+    if not isinstance(input, Artifact):
+        raise FileFormatError(f"{input}: front-dynamics needs the lineage of its input (a "
+                              "stickslip.lineage.Artifact naming the solver that wrote it)")
+    solver = registry.get("solver", input.plugin)
+    if solver.replay is None:
+        raise FileFormatError(f"{input}: solver {solver.name!r} that wrote it cannot replay events")
+    return solver.replay(input.path)
+
+
+@register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
-    from ..fem.output import read_increments, read_run_attrs, rerun_with_failures  # loads numba kernels
+    from ..fem.output import interface_layers, read_increments, read_run_attrs
 
+    replay = _replay(input)
     run_attrs = read_run_attrs(input)
     for key in ("N", "h", "c_s"):
         if key not in run_attrs:
             raise FileFormatError(f"{input}: run attributes lack {key}")
     N = int(run_attrs["N"])
     with h5io.open_file(input) as file:
-        spacing = interface_spacing(load_mesh(file["mesh"]).layer_mid_height)
+        heights = load_mesh(file["mesh"]).layer_mid_height
+    spacing = interface_spacing(heights[interface_layers(run_attrs["n_interfaces"])])
     classified = extraction.classify_increments(read_increments(input), N, source=str(input))
-    failures, fronts = front_tables(classified, lambda increment: rerun_with_failures(input, increment), N=N,
-                                    h=float(run_attrs["h"]), c_s=float(run_attrs["c_s"]), spacing=spacing,
-                                    params=params)
+    failures, fronts = front_tables(classified, replay.failures, N=N, h=float(run_attrs["h"]),
+                                    c_s=float(run_attrs["c_s"]), spacing=spacing, params=params)
     attrs = {**event_attrs(run_attrs, classified, source=str(input)), "interface_spacing": spacing}
-    write_front_file(failures, fronts, attrs, output)
+    write_front_file(failures, fronts, attrs, output, input=input, params=params)

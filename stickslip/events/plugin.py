@@ -1,7 +1,11 @@
-"""The ``numerical-events`` analysis plugin: one ``fem`` run in, its event tables out.
+"""The ``numerical-events`` analysis plugin: one ``fem-run`` file in, an ``event-table`` file out.
 
-Output file (HDF5, tables as in :func:`stickslip.h5io.write_table`):
+Output file (format ``event-table``, header of :mod:`stickslip.formats.analysis_file`;
+tables as in :func:`stickslip.h5io.write_table`):
 
+``slip_events``
+    the normalised slip table that the database ingests (:mod:`stickslip.formats.event_table`):
+    ``event`` (index of the steady-state slip event), ``interface``, ``multi``, ``dmu``, ``increment``;
 ``increments``
     every stored increment, classified (:func:`~stickslip.events.extraction.classify_increments`);
 ``slips``
@@ -14,20 +18,25 @@ Output file (HDF5, tables as in :func:`stickslip.h5io.write_table`):
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
 plus ``phi`` (the rigidity ratio Phi, :func:`~stickslip.fem.stiffness.stiffness_ratio`),
 ``regime`` ("stiff" or "compliant", from ``phi``), ``steady_state`` (first steady-state increment,
--1 if not reached), ``analysis`` and ``analysis_version``.
+-1 if not reached) and the analysis header.
 """
 
 import dataclasses
 import json
 
-from .. import h5io
+import numpy as np
+import pandas as pd
+
 from ..fem.stiffness import driving_regime, stiffness_ratio
+from ..formats.analysis_file import write_analysis_file
+from ..formats.event_table import slip_events_table
 from ..h5io import FileFormatError
 from ..registry import register
 from . import extraction
 
-__all__ = ["EventParams", "VERSION", "event_tables", "event_attrs", "write_event_file", "run"]
+__all__ = ["EventParams", "NAME", "VERSION", "event_tables", "slip_events", "event_attrs", "write_event_file", "run"]
 
+NAME = "numerical-events"
 VERSION = "1"
 
 
@@ -51,16 +60,39 @@ def event_tables(increments, N, *, source="increment table"):
     Returns
     -------
     dict[str, pandas.DataFrame]
-        ``increments``, ``slips``, ``slip_interfaces``, ``sequences``.
+        ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``.
     """
     classified = extraction.classify_increments(increments, N, source=source)
     slips = extraction.slip_events(classified, N)
+    per_interface = extraction.slip_interfaces(classified, N)
     return {
         "increments": classified,
         "slips": slips,
-        "slip_interfaces": extraction.slip_interfaces(classified, N),
+        "slip_interfaces": per_interface,
         "sequences": extraction.slip_sequences(slips),
+        "slip_events": slip_events(per_interface),
     }
+
+
+def slip_events(per_interface):
+    """The normalised slip table (format ``event-table``) of a run's ``slip_interfaces`` table.
+
+    Parameters
+    ----------
+    per_interface : pandas.DataFrame
+        Output of :func:`~stickslip.events.extraction.slip_interfaces`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``event`` (steady-state slip events numbered from 0 in increment order), ``interface``,
+        ``multi``, ``dmu`` [sig0], ``increment``, then ``dgamma`` [gamma0].
+    """
+    increment = per_interface["increment"].to_numpy()
+    return slip_events_table(pd.DataFrame({
+        "event": np.unique(increment, return_inverse=True)[1].reshape(-1), "interface": per_interface["a"],
+        "multi": ~per_interface["single"].to_numpy(dtype=bool), "dmu": per_interface["dmu"],
+        "increment": increment, "dgamma": per_interface["dgamma"]}))
 
 
 def event_attrs(run_attrs, classified, *, source="run"):
@@ -94,8 +126,8 @@ def event_attrs(run_attrs, classified, *, source="run"):
     return attrs
 
 
-def write_event_file(tables, attrs, output):
-    """Write the event tables and attributes to ``output`` (atomically).
+def write_event_file(tables, attrs, output, *, input, params=EventParams()):
+    """Write the event tables and attributes to ``output`` (atomically, format ``event-table``).
 
     Parameters
     ----------
@@ -104,14 +136,15 @@ def write_event_file(tables, attrs, output):
     attrs : Mapping[str, object]
         Output of :func:`event_attrs`.
     output : str or pathlib.Path
+    input : str or os.PathLike
+        The analysed run file (its checksum goes into the header).
+    params : EventParams, optional
     """
-    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
-        h5io.write_attrs(file, {**attrs, "analysis": "numerical-events", "analysis_version": VERSION})
-        for name, table in tables.items():
-            h5io.write_table(file, name, table)
+    write_analysis_file(output, "event-table", analysis=NAME, version=VERSION, params=params, input=input,
+                        attrs=attrs, tables=tables)
 
 
-@register("analysis", "numerical-events", VERSION, EventParams, inputs=("fem",))
+@register("analysis", NAME, VERSION, EventParams, consumes=("fem-run",), produces="event-table")
 def run(params, input, output):
     """Slip and microscopic events of a quasistatic fem run (steady state, rho(s), sequences)."""
     from ..fem.output import read_increments, read_run_attrs  # the solver loads numba kernels
@@ -120,4 +153,5 @@ def run(params, input, output):
     if "N" not in run_attrs:
         raise FileFormatError(f"{input}: run attributes lack N")
     tables = event_tables(read_increments(input), int(run_attrs["N"]), source=str(input))
-    write_event_file(tables, event_attrs(run_attrs, tables["increments"], source=str(input)), output)
+    write_event_file(tables, event_attrs(run_attrs, tables["increments"], source=str(input)), output, input=input,
+                     params=params)

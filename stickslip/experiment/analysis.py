@@ -1,10 +1,13 @@
 """The ``experiment-events`` analysis: every slip of one experimental recording, with its
 interface, force drop, friction drop, waiting time, aging rate and slow slip.
 
-Input: one time-series file (:mod:`stickslip.experiment.timeseries`; lab recording or ``lever``
-run). Output: one HDF5 file with two tables (:func:`stickslip.h5io.write_table`) and the run's
-attributes copied to the root:
+Input: one ``timeseries`` file (:mod:`stickslip.experiment.timeseries`; lab recording or ``lever``
+run). Output: one ``event-table`` file (header of :mod:`stickslip.formats.analysis_file`) with three
+tables (:func:`stickslip.h5io.write_table`) and the run's attributes copied to the root:
 
+``slip_events``: the normalised slip table that the database ingests
+(:mod:`stickslip.formats.event_table`): ``event``, ``interface``, ``multi``, ``slip`` (dR),
+``dmu``, ``time`` (t).
 ``slips``: one row per slip of one interface, sorted by time (see :func:`analyse_record`).
 ``interfaces``: one row per interface ``a``: ``driven`` (it can slip: ``a <= n`` in the stack,
 ``a`` the driven slab in the individual protocol), ``R_tot`` [mm] (total sliding over the analysed
@@ -17,20 +20,20 @@ drift.
 """
 
 import dataclasses
-import hashlib
-import json
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .. import h5io, registry
-from ..params import ParameterError, param, params_to_dict
+from ..formats.analysis_file import write_analysis_file
+from ..formats.event_table import slip_events_table
+from ..params import ParameterError, param
 from . import aging, detection, kinematics
 from .timeseries import read_timeseries
 
-__all__ = ["ExperimentEventsParams", "analyse_record", "run", "VERSION"]
+__all__ = ["ExperimentEventsParams", "analyse_record", "slip_events", "run", "NAME", "VERSION"]
 
+NAME = "experiment-events"
 VERSION = "2"
 
 SLIP_COLUMNS = ["event", "t", "a", "n", "protocol", "multi", "t_start", "t_end", "dF", "dmu", "T", "dR",
@@ -139,28 +142,28 @@ def analyse_record(record, params=ExperimentEventsParams()):
     return slips, interfaces
 
 
-def _sha256(path):
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for chunk in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
+def slip_events(slips):
+    """The normalised slip table (format ``event-table``) of :func:`analyse_record`'s ``slips``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``event``, ``interface`` (a), ``multi``, ``slip`` (dR) [mm], ``dmu`` [-], ``time`` (t) [s], then
+        the other numeric columns of ``slips`` (``dF``, ``T``, ``B_a``, ``dR_from_dF``, ``drift``, ...).
+    """
+    standard = {"event": "event", "a": "interface", "multi": "multi", "dR": "slip", "dmu": "dmu", "t": "time"}
+    further = [c for c in slips.columns if c not in standard and slips[c].dtype.kind in "biuf" and c != "n"]
+    return slip_events_table(pd.concat([slips[list(standard)].rename(columns=standard), slips[further]], axis=1))
 
 
-@registry.register("analysis", "experiment-events", VERSION, ExperimentEventsParams,
-                   inputs=("lever", "rate-state-lever"))
+@registry.register("analysis", NAME, VERSION, ExperimentEventsParams, consumes=("timeseries",),
+                   produces="event-table")
 def run(params, input, output):
     """Detect and measure every slip of one experimental time series (lab or lever run)."""
-    input = Path(input)
     record = read_timeseries(input)
     slips, interfaces = analyse_record(record, params)
     with h5io.open_file(input) as source:
         run_attrs = dict(source.attrs)
-    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as f:
-        for key, value in run_attrs.items():
-            f.attrs[key] = value
-        h5io.write_attrs(f, {"analysis": "experiment-events", "analysis_version": VERSION,
-                             "analysis_params": json.dumps(params_to_dict(params), sort_keys=True),
-                             "input_sha256": _sha256(input)})
-        h5io.write_table(f, "slips", slips)
-        h5io.write_table(f, "interfaces", interfaces)
+    write_analysis_file(output, "event-table", analysis=NAME, version=VERSION, params=params, input=input,
+                        attrs=run_attrs, tables={"slip_events": slip_events(slips), "slips": slips,
+                                                 "interfaces": interfaces})

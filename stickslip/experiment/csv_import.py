@@ -21,7 +21,6 @@ values, the line: missing or unexpected columns, missing or unknown units, non-n
 NaN/inf values, times that do not strictly increase, fewer than two rows.
 """
 
-import hashlib
 import re
 from pathlib import Path
 
@@ -29,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from ..h5io import FileFormatError
+from ..hashing import sha256_file
 from .timeseries import ExperimentRecord, write_timeseries
 
 __all__ = ["UNITS", "import_csv", "read_csv_columns"]
@@ -148,10 +148,6 @@ def _data_line_numbers(path, n_rows):
     return numbers[1:n_rows + 1]
 
 
-def _sha256(path):
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
 def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stack", a=0, normal_force=49.0,
                k_spring=55.0, h=10.0, H=100.0, V=0.01, time_unit=None, force_unit=None, position_unit=None):
     """Convert a lab export (force CSV + positions CSV) into a time-series HDF5 file.
@@ -192,7 +188,7 @@ def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stac
     x = np.column_stack([positions[f"x{i}"] for i in range(1, n_slabs + 1)])
     record = ExperimentRecord(t_F=force["t"], F=force["F"], t_x=positions["t"], x=x, n=n, n_slabs=n_slabs,
                               protocol=protocol, a=a, normal_force=normal_force, k_spring=k_spring, h=h, H=H, V=V)
-    source = {"force_csv": {"name": Path(force_csv).name, "sha256": _sha256(force_csv)},
-              "positions_csv": {"name": Path(positions_csv).name, "sha256": _sha256(positions_csv)}}
+    source = {"force_csv": {"name": Path(force_csv).name, "sha256": sha256_file(force_csv)},
+              "positions_csv": {"name": Path(positions_csv).name, "sha256": sha256_file(positions_csv)}}
     write_timeseries(output, record, attrs={"imported_from": source})
     return record

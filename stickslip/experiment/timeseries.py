@@ -1,4 +1,4 @@
-"""The experimental time-series format: one HDF5 file per run, for lab and virtual data.
+"""The ``timeseries`` format (experimental recordings): one HDF5 file per run, lab or virtual data.
 
 Layout (``shared/design.md``, section "Experimental time-series format"):
 
@@ -19,6 +19,7 @@ attr ``k_spring`` float              K [N/mm]
 attr ``h``       float               slab thickness [mm]
 attr ``H``       float               lever height [mm]
 attr ``V``       float               lever-top speed actually imposed [mm/s]
+attr ``format``  str                 ``"timeseries"``, with ``format_version``
 ===============  ==================  ==============================================
 
 Protocols (paper, section "Experiments" and appendix "Individual sliding"):
@@ -40,10 +41,13 @@ import dataclasses
 
 import numpy as np
 
-from .. import h5io
+from .. import formats, h5io
 
-__all__ = ["PROTOCOLS", "ExperimentRecord", "write_timeseries", "read_timeseries", "read_truth",
-           "validate_record"]
+__all__ = ["FORMAT", "PROTOCOLS", "ExperimentRecord", "write_timeseries", "read_timeseries", "read_truth",
+           "validate_record", "describe"]
+
+#: The format name of these files (:mod:`stickslip.formats`).
+FORMAT = "timeseries"
 
 #: The known driving protocols.
 PROTOCOLS = ("stack", "individual")
@@ -203,11 +207,12 @@ def write_timeseries(path, record, *, attrs=None, tables=None):
         If an extra attribute or table would overwrite an item of the format.
     """
     validate_record(record, source=str(path))
-    reserved = set(_DATASETS) | set(_INT_ATTRS) | set(_FLOAT_ATTRS) | {"protocol"}
+    reserved = set(_DATASETS) | set(_INT_ATTRS) | set(_FLOAT_ATTRS) | {"protocol", "format", "format_version"}
     clashes = sorted(reserved & (set(attrs or {}) | set(tables or {})))
     if clashes:
         raise ValueError(f"extra attributes/tables must not reuse the format's names: {', '.join(clashes)}")
     with h5io.atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
+        formats.stamp(f, FORMAT)
         for name in _DATASETS:
             h5io.write_dataset(f, name, np.asarray(getattr(record, name), dtype=np.float64), **_COMPRESSION)
         for name in _INT_ATTRS:
@@ -242,6 +247,7 @@ def read_timeseries(path):
     source = str(path)
     values = {}
     with h5io.open_file(path) as f:
+        formats.check(f, FORMAT)
         for name in _DATASETS:
             if name not in f:
                 _fail(source, name, "is missing (required dataset)")
@@ -296,3 +302,20 @@ def read_truth(path, table="truth"):
         if table not in f:
             return None
         return h5io.read_table(f, table)
+
+
+def describe(path):
+    """The results database's simulation columns of a ``timeseries`` file (:func:`stickslip.formats.describe`).
+
+    Returns
+    -------
+    dict[str, object]
+        ``protocol``, ``n`` (driven slabs), ``a`` (slab driven alone, 0 for the stack) and
+        ``seed`` (None for lab data, which has no seed attribute).
+    """
+    with h5io.open_file(path) as f:
+        formats.check(f, FORMAT)
+        protocol = f.attrs["protocol"]
+        seed = f.attrs.get("seed")
+        return {"protocol": protocol.decode() if isinstance(protocol, bytes) else str(protocol),
+                "n": int(f.attrs["n"]), "a": int(f.attrs["a"]), "seed": None if seed is None else int(seed)}

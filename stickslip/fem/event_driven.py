@@ -17,8 +17,8 @@ Reference: shared/reference-model.md, section 8a-8b.
 import numpy as np
 
 from ..numba_options import njit
-from .forces import interface_strain
 from .materials import equivalent_strain, well_index
+from .quad4 import element_strain
 
 __all__ = ["step_size", "autoscale", "BISECTION_RTOL", "MAX_BISECTIONS"]
 
@@ -40,7 +40,7 @@ def _yields(epsy, dofs, dNdx, u, du, idx, s, yield_element):
     for e in range(idx.shape[0]):
         for a in range(8):
             ue[a] = u[dofs[e, a]] + s * du[dofs[e, a]]
-        interface_strain(dNdx[e], ue, eps)
+        element_strain(dNdx[e], ue, eps)
         changed = 0
         for q in range(4):
             if well_index(epsy[e], equivalent_strain(eps[q, 0], eps[q, 1], eps[q, 2]), idx[e, q]) != idx[e, q]:

@@ -20,39 +20,10 @@ from numba import prange
 
 from ..numba_options import njit
 from .materials import cusp_stress, equivalent_strain, well_index
+from .quad4 import element_strain
 from .structured import apply_stencils
 
-__all__ = ["compute_force", "compute_force_in_wells", "wells_hold", "interface_strain", "layer_ubar"]
-
-
-@njit
-def interface_strain(dNdx, ue, out):
-    """Strain ``(xx, yy, xy)`` at the 4 Gauss points of one element.
-
-    Parameters
-    ----------
-    dNdx : numpy.ndarray
-        [4, 4, 2] gradients of the element [1/length].
-    ue : numpy.ndarray
-        [8] element displacement (node-major, x then y) [length].
-    out : numpy.ndarray
-        [4, 3] written.
-    """
-    for q in range(4):
-        xx = 0.0
-        yy = 0.0
-        xy = 0.0
-        for m in range(4):
-            gx = dNdx[q, m, 0]
-            gy = dNdx[q, m, 1]
-            ux = ue[2 * m]
-            uy = ue[2 * m + 1]
-            xx += gx * ux
-            yy += gy * uy
-            xy += gy * ux + gx * uy
-        out[q, 0] = xx
-        out[q, 1] = yy
-        out[q, 2] = 0.5 * xy
+__all__ = ["compute_force", "compute_force_in_wells", "wells_hold", "layer_ubar"]
 
 
 @njit
@@ -70,7 +41,7 @@ def _interface_elements(lo, hi, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, 
     for e in range(lo, hi):
         for a in range(8):
             ue[a] = u[iface_dofs[e, a]]
-        interface_strain(dNdx[e], ue, eps[e])
+        element_strain(dNdx[e], ue, eps[e])
         for a in range(8):
             fe[e, a] = 0.0
         for q in range(4):

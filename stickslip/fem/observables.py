@@ -19,9 +19,8 @@ import numpy as np
 
 from ..numba_options import njit
 from .assembly import element_dofs
-from .forces import interface_strain
 from .materials import elastic_stress, equivalent_strain, equivalent_stress
-from .quad4 import element_coordinates, shape_gradients
+from .quad4 import element_coordinates, element_strain, shape_gradients
 
 __all__ = ["Observer", "layer_strain_sums", "observable_columns"]
 
@@ -55,7 +54,7 @@ def layer_strain_sums(u, edofs, dNdx, dV, elem_layer, nlayer):
     for e in range(edofs.shape[0]):
         for a in range(8):
             ue[a] = u[edofs[e, a]]
-        interface_strain(dNdx[e], ue, eps)
+        element_strain(dNdx[e], ue, eps)
         for q in range(4):
             for c in range(3):
                 out[elem_layer[e], c] += eps[q, c] * dV[e, q]

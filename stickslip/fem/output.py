@@ -1,15 +1,21 @@
-"""The simulation file: layout, appending increments, reading results, time-resolved reruns.
+"""The ``fem-run`` format: layout, writing a run increment by increment, reading it back.
 
-One HDF5 file per run (written with :mod:`stickslip.h5io`, so equal runs give equal bytes):
+The writer works on arrays and tables (no solver object), so any solver that produces
+this format writes it through here. One HDF5 file per run (written with
+:mod:`stickslip.h5io`, so equal runs give equal bytes):
 
 ``/`` attributes
-    ``solver`` ("fem"), ``version`` (package), ``params`` (JSON of all :class:`FemParams`),
+    ``format`` ("fem-run"), ``format_version``, ``solver`` and ``solver_version`` (the
+    plugin that wrote it), ``version`` (package), ``params`` (JSON of all :class:`FemParams`),
     the main parameters again as typed attributes (``N``, ``plates``, ``n_interfaces``,
     ``k_drive``, ``drive``, ``seed``, ``nchunk``), normalisation (``eps0``, ``sig0``,
-    ``gamma0`` [deg], ``c_s``, ``h``, ``dt``, ``alpha``, ``H``), ``nstored`` (complete
-    increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or "max_increments").
+    ``gamma0`` [deg], ``c_s``, ``h``, ``dt``, ``alpha``, ``H``), the rigidity ratio ``phi``
+    and the driving ``regime`` ("stiff" or "compliant", :mod:`.stiffness`), ``nstored``
+    (complete increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or
+    "max_increments").
 ``/mesh``
-    The layered mesh (:func:`stickslip.mesh.save_mesh`).
+    The layered mesh (:func:`stickslip.mesh.save_mesh`); with it the run's own interface
+    <-> layer map (:func:`interface_layers`).
 ``/event``
     Scaled linear response: ``delta_u`` [ndof], ``delta_eps`` [ni, 4, 3],
     ``delta_target`` [nlayer], ``delta_lever`` [1].
@@ -25,58 +31,73 @@ One HDF5 file per run (written with :mod:`stickslip.h5io`, so equal runs give eq
 import json
 
 import numpy as np
-import pandas as pd
 
-from .. import __version__
+from .. import __version__, formats
 from ..h5io import FileFormatError, atomic_output, copy_file, open_file, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
-from ..params import parse_params, params_to_dict
-from .stiffness import driving_regime, stiffness_ratio
-from .observables import observable_columns
+from ..params import parse_params
 from .parameters import FemParams
 
-__all__ = ["create_file", "append_increment", "rewrite", "read_increments", "read_run_attrs", "read_params", "RunFile",
-           "rerun_with_failures"]
+__all__ = ["FORMAT", "create_file", "append_increment", "rewrite", "read_increments", "read_run_attrs", "read_params",
+           "RunFile", "interface_layers", "describe"]
+
+#: The format name of these files (:mod:`stickslip.formats`).
+FORMAT = "fem-run"
 
 _STATE = ("u", "target", "lever_target", "t")
 
 
-def create_file(file, system, observer):
-    """Write the header of a new simulation file (no increment yet).
+def interface_layers(n_interfaces):
+    """The interface <-> layer map of a run: interface ``a`` is layer ``2a - 1``.
+
+    Layers are numbered from the bottom: plate ``i`` is layer ``2i``, interface ``a``
+    (1 = lowest) the block layer ``2a - 1`` between plates ``a - 1`` and ``a``.
+
+    Parameters
+    ----------
+    n_interfaces : int
+
+    Returns
+    -------
+    numpy.ndarray
+        int64 [n_interfaces]: the layer of interface ``a`` at index ``a - 1``.
+    """
+    return 2 * np.arange(1, int(n_interfaces) + 1, dtype=np.int64) - 1
+
+
+def create_file(file, header, mesh, linear_response, columns):
+    """Write the header of a new ``fem-run`` file (no increment yet).
 
     Parameters
     ----------
     file : h5py.File
         Open for writing, empty.
-    system : System
-        With its linear response set.
-    observer : Observer
+    header : Mapping[str, object]
+        Root attributes: ``solver``, ``solver_version``, ``params`` (dict of :class:`FemParams`),
+        the typed parameters, normalisation, ``phi`` and ``regime`` of the module docstring.
+    mesh : stickslip.mesh.LayeredMesh
+    linear_response : tuple
+        ``(delta_u [ndof], delta_eps [ni, 4, 3], delta_target [nlayer], delta_lever)``.
+    columns : Sequence[str]
+        Columns of the observables table after ``increment``, ``kick``, ``yield_element``.
     """
-    p = system.params
-    c = system.constants
-    phi = stiffness_ratio(p.k_drive, p.N, p.G)
-    write_attrs(file, {
-        "solver": "fem", "version": __version__, "params": params_to_dict(p),
-        "N": p.N, "plates": p.plates, "n_interfaces": p.plates - 1, "k_drive": p.k_drive, "drive": p.drive,
-        "seed": p.seed, "nchunk": p.nchunk, "eps0": p.eps0, "sig0": c["sig0"], "gamma0": observer.gamma0,
-        "c_s": c["c_s"], "h": c["h"], "dt": c["dt"], "alpha": c["alpha"], "H": c["H"],
-        "nstored": 0, "completed": False, "stop_reason": "", "phi": phi, "regime": driving_regime(phi),
-    })
-    save_mesh(system.mesh, file.create_group("mesh"))
+    formats.stamp(file, FORMAT)
+    write_attrs(file, {**header, "version": __version__, "nstored": 0, "completed": False, "stop_reason": ""})
+    save_mesh(mesh, file.create_group("mesh"))
+    delta_u, delta_eps, delta_target, delta_lever = linear_response
     event = file.create_group("event")
-    write_dataset(event, "delta_u", system.delta_u)
-    write_dataset(event, "delta_eps", system.delta_eps)
-    write_dataset(event, "delta_target", system.delta_target)
-    write_dataset(event, "delta_lever", np.array([system.delta_lever]))
+    write_dataset(event, "delta_u", delta_u)
+    write_dataset(event, "delta_eps", delta_eps)
+    write_dataset(event, "delta_target", delta_target)
+    write_dataset(event, "delta_lever", np.array([delta_lever]))
     state = file.create_group("state")
-    ndof, nlayer = system.model.ndof, system.model.layer_volume.size
+    ndof, nlayer = np.size(delta_u), np.size(delta_target)
     write_dataset(state, "u", np.zeros((0, ndof)), maxshape=(None, ndof), chunks=(1, ndof))
     write_dataset(state, "target", np.zeros((0, nlayer)), maxshape=(None, nlayer), chunks=(64, nlayer))
     for name in ("lever_target", "t"):
         write_dataset(state, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
     table = file.create_group("increments")
-    columns = ["increment", "kick", "yield_element"] + observable_columns(observer.nlayer, observer.n_interfaces,
-                                                                          system.model.free_lever)
+    columns = ["increment", "kick", "yield_element"] + list(columns)
     dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool}
     for name in columns:
         dtype = dtypes.get(name, np.int64 if name[:2] in ("S_", "A_") else np.float64)
@@ -90,7 +111,7 @@ def _append(dataset, value):
     dataset[n] = value
 
 
-def append_increment(file, system, row):
+def append_increment(file, state, row):
     """Append one increment (state and observables) and commit it.
 
     The rows are flushed first, then ``nstored`` is raised and flushed: a process
@@ -100,12 +121,12 @@ def append_increment(file, system, row):
     Parameters
     ----------
     file : h5py.File
-    system : System
+    state : tuple
+        ``(u [ndof], target [nlayer], lever_target, t)``: what restores the increment.
     row : dict
         ``increment``, ``kick``, ``yield_element`` and the observables.
     """
-    u, target, lever_target, t = system.snapshot()
-    for name, value in zip(_STATE, (u, target, lever_target, t)):
+    for name, value in zip(_STATE, state):
         _append(file["state"][name], value)
     table = file["increments"]
     for name in json.loads(table.attrs["columns"]):
@@ -143,11 +164,10 @@ def read_params(file):
     Raises
     ------
     FileFormatError
-        If the file is not a ``fem`` simulation file.
+        If the file is not a ``fem-run`` file of the current version.
     """
-    if file.attrs.get("solver") != "fem" or "params" not in file.attrs:
-        raise FileFormatError(f"{file.filename}: not a fem simulation file (attribute 'solver' != 'fem')")
-    return parse_params(FemParams, json.loads(file.attrs["params"]), owner="solver 'fem'")
+    formats.check(file, FORMAT)
+    return parse_params(FemParams, json.loads(file.attrs["params"]), owner=f"{file.filename}: params")
 
 
 class RunFile:
@@ -219,51 +239,16 @@ def read_run_attrs(path):
         return out
 
 
-def rerun_with_failures(path, increment):
-    """Redo the kick and minimisation of one increment, recording every block failure.
-
-    The state of ``increment - 1`` is restored, the stored kick is redone (with the
-    whole-element fallback if the increment used it) and the minimisation records
-    every change of the well index of Gauss point 0 of the interface blocks (the
-    kick's own change at ``t = 0`` included). The result must reproduce the stored
-    increment exactly (asserted).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-    increment : int
-        A stored kick increment (>= 2).
+def describe(path):
+    """The results database's simulation columns of a ``fem-run`` file (:func:`stickslip.formats.describe`).
 
     Returns
     -------
-    pandas.DataFrame
-        Columns ``a`` (interface, 1 = lowest), ``block`` (0 ... N-1), ``t`` (time since the
-        kick [FE time units]), ``direction`` (+1 / -1); one row per well hop, in time order.
-
-    Raises
-    ------
-    FileFormatError
-        If the increment is not a stored kick.
+    dict[str, object]
+        ``n`` (interfaces), ``plates``, ``blocks`` (N), ``k_drive``, ``phi`` and ``regime``
+        (the file's own attributes, :mod:`.stiffness`), ``seed``.
     """
-    from .system import System
-
-    with open_file(path) as file:
-        run = RunFile(file)
-        table = read_table(file, "increments", rows=run.nstored)
-        if not 1 <= increment < run.nstored or not bool(table["kick"][increment]):
-            raise FileFormatError(f"{path}: increment {increment} is not a stored kick increment")
-        yield_element = bool(table["yield_element"][increment])
-        before = run.state(increment - 1)
-        after = run.state(increment)
-        response = run.linear_response()
-        system = System(run.params, run.mesh)
-    system.set_linear_response(*response)
-    system.restore(*before)
-    t0 = before[3]
-    N = run.mesh.N
-    niter, events = system.kick_and_minimise(yield_element, run.params.margin, record=True)
-    if niter == 0 or not np.array_equal(system.state.u, after[0]) or system.state.t[0] != after[3]:
-        raise AssertionError(f"{path}: rerunning increment {increment} did not reproduce the stored state")
-    element = events[:, 0].astype(np.int64)
-    return pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - t0,
-                         "direction": events[:, 2].astype(np.int64)})
+    attrs = read_run_attrs(path)
+    return {"n": int(attrs["n_interfaces"]), "plates": int(attrs["plates"]), "blocks": int(attrs["N"]),
+            "k_drive": float(attrs["k_drive"]), "phi": float(attrs["phi"]), "regime": str(attrs["regime"]),
+            "seed": int(attrs["seed"])}

@@ -10,7 +10,9 @@ thickness: "volume" is an area [length^2].
 
 import numpy as np
 
-__all__ = ["GAUSS_XI", "NODAL_XI", "shape_functions", "shape_gradients", "element_coordinates"]
+from ..numba_options import njit
+
+__all__ = ["GAUSS_XI", "NODAL_XI", "shape_functions", "shape_gradients", "element_coordinates", "element_strain"]
 
 _CORNERS = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
 
@@ -98,3 +100,33 @@ def shape_gradients(xe, xi=GAUSS_XI):
     inv[..., 1, 0] = -J[..., 1, 0] / det
     dNdx = np.einsum("qmj,eqji->eqmi", dNdxi, inv)
     return dNdx, det
+
+
+@njit
+def element_strain(dNdx, ue, out):
+    """Strain ``(xx, yy, xy)`` at the 4 Gauss points of one element (small strain, symmetric gradient).
+
+    Parameters
+    ----------
+    dNdx : numpy.ndarray
+        [4, 4, 2] gradients of the element [1/length].
+    ue : numpy.ndarray
+        [8] element displacement (node-major, x then y) [length].
+    out : numpy.ndarray
+        [4, 3] written.
+    """
+    for q in range(4):
+        xx = 0.0
+        yy = 0.0
+        xy = 0.0
+        for m in range(4):
+            gx = dNdx[q, m, 0]
+            gy = dNdx[q, m, 1]
+            ux = ue[2 * m]
+            uy = ue[2 * m + 1]
+            xx += gx * ux
+            yy += gy * uy
+            xy += gy * ux + gx * uy
+        out[q, 0] = xx
+        out[q, 1] = yy
+        out[q, 2] = 0.5 * xy

@@ -26,8 +26,9 @@ from .. import progress
 from ..h5io import FileFormatError, UnreadableFileError, atomic_output, open_file, writer_lock
 from ..params import params_to_dict
 from .minimise import within_margin
-from .observables import Observer
+from .observables import Observer, observable_columns
 from .output import RunFile, append_increment, create_file, read_params, rewrite
+from .stiffness import driving_regime, stiffness_ratio
 from .system import System
 
 __all__ = ["run_simulation"]
@@ -64,14 +65,27 @@ class _Progress:
         self.bar.update(1)
 
 
-def _create(path, params, mesh, threads):
+def _header(system, observer, producer):
+    """Root attributes of the run file: the producing solver, parameters, normalisation."""
+    p, c = system.params, system.constants
+    phi = stiffness_ratio(p.k_drive, p.N, p.G)
+    return {"solver": producer[0], "solver_version": producer[1], "params": params_to_dict(p),
+            "N": p.N, "plates": p.plates, "n_interfaces": p.plates - 1, "k_drive": p.k_drive, "drive": p.drive,
+            "seed": p.seed, "nchunk": p.nchunk, "eps0": p.eps0, "sig0": c["sig0"], "gamma0": observer.gamma0,
+            "c_s": c["c_s"], "h": c["h"], "dt": c["dt"], "alpha": c["alpha"], "H": c["H"],
+            "phi": phi, "regime": driving_regime(phi)}
+
+
+def _create(path, params, mesh, threads, producer):
     system = System(params, mesh, threads=threads)
     system.compute_linear_response()
     observer = Observer(system)
+    columns = observable_columns(observer.nlayer, observer.n_interfaces, system.model.free_lever)
+    response = (system.delta_u, system.delta_eps, system.delta_target, system.delta_lever)
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
-            create_file(file, system, observer)
-            append_increment(file, system, _row(observer, 0, True, False, observer.well_index()))
+            create_file(file, _header(system, observer, producer), system.mesh, response, columns)
+            append_increment(file, system.snapshot(), _row(observer, 0, True, False, observer.well_index()))
 
 
 def _stored(output, params):
@@ -108,7 +122,7 @@ def _aside(path):
     return aside
 
 
-def run_simulation(params, output, mesh, threads=1):
+def run_simulation(params, output, mesh, threads=1, *, producer):
     """Run (or resume, or skip if completed) one simulation into ``output``.
 
     While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,
@@ -128,6 +142,8 @@ def run_simulation(params, output, mesh, threads=1):
         Used when the file is created (a resumed file uses its own stored mesh).
     threads : int, optional
         Threads of the parallel kernels (1: serial); the file does not depend on it.
+    producer : tuple[str, str]
+        Name and version of the solver plugin, recorded in the file.
 
     Returns
     -------
@@ -146,7 +162,7 @@ def run_simulation(params, output, mesh, threads=1):
         if completed:
             return 0
         if completed is None:
-            _create(output, params, mesh, threads)
+            _create(output, params, mesh, threads, producer)
         else:
             rewrite(output)
         new, reason = _increments(params, output, threads)
@@ -186,7 +202,7 @@ def _increments(params, output, threads):
                 if not system.extend and not within_margin(system.model, system.state.idx, params.margin):
                     reason = "margin"
                     break
-            append_increment(file, system, _row(observer, increment, kick, yield_element, previous_index))
+            append_increment(file, system.snapshot(), _row(observer, increment, kick, yield_element, previous_index))
             previous_index = observer.well_index()
             new += 1
             report.stored(file, increment)

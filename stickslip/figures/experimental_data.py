@@ -1,23 +1,21 @@
-"""What the experimental figures share: reading ``experiment-events`` files, finding the
-time series a table came from, and the time excerpts of panels.
+"""What the experimental figures share: reading ``experiment-events`` files, the time series
+a table came from (its lineage), and the time excerpts of panels.
 
-Every figure receives lists of paths and groups runs by the attributes stored in the files:
-``n`` (driven slabs), ``protocol`` ("stack" or "individual") and ``a`` (slab driven alone).
+Every figure receives the ``experiment-events`` outputs as artifacts, each with the time series
+it analysed as ``parent`` (:class:`stickslip.lineage.Artifact`), and groups runs by the
+attributes stored in the files: ``n`` (driven slabs), ``protocol`` ("stack" or "individual")
+and ``a`` (slab driven alone).
 """
-
-import hashlib
-from pathlib import Path
 
 import pandas as pd
 
 from .. import h5io
 from ..experiment.timeseries import read_timeseries
 
-__all__ = ["EVENTS", "LEVER", "load_slips", "load_interfaces", "example_run", "excerpt"]
+__all__ = ["EVENTS", "load_slips", "load_interfaces", "example_run", "excerpt"]
 
-#: Input categories of the experimental figures.
+#: Input category of the experimental figures.
 EVENTS = "analysis:experiment-events"
-LEVER = "solver:lever"
 
 _RUN_ATTRS = ("n", "protocol", "a", "seed", "normal_force", "k_spring", "h", "H", "V")
 
@@ -73,20 +71,15 @@ def load_interfaces(paths):
     return _load(paths, "interfaces")
 
 
-def _sha256(path):
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-def example_run(slips, lever_paths, *, n, protocol="stack"):
+def example_run(slips, events, *, n, protocol="stack"):
     """The first run (sorted by seed, then path) with ``n`` and ``protocol``: its time series and slips.
 
     Parameters
     ----------
     slips : pandas.DataFrame
         :func:`load_slips` of the ``experiment-events`` files.
-    lever_paths : list of str or pathlib.Path
-        Time-series files; a table is matched to its time series by the SHA-256 of the analysed
-        file (attribute ``input_sha256`` of the table's file).
+    events : list of stickslip.lineage.Artifact
+        The ``experiment-events`` outputs, each with its time series as ``parent``.
     n : int
     protocol : str
 
@@ -98,21 +91,17 @@ def example_run(slips, lever_paths, *, n, protocol="stack"):
     Raises
     ------
     stickslip.h5io.FileFormatError
-        If no such run, or no time series matching its table, is given.
+        If no such run is given, or its events file comes without its time series.
     """
     runs = slips[(slips["n"] == n) & (slips["protocol"] == protocol)]
     if runs.empty:
         raise h5io.FileFormatError(f"no {EVENTS} file with n = {n} and protocol '{protocol}' among the inputs")
     order = runs.sort_values([c for c in ("seed", "file") if c in runs.columns])
     chosen = order["file"].iloc[0]
-    with h5io.open_file(chosen) as f:
-        digest = f.attrs["input_sha256"]
-    for path in lever_paths:
-        with h5io.open_file(path) as f:
-            same = int(f.attrs.get("n", -1)) == n and f.attrs.get("protocol", "") == protocol
-        if same and _sha256(path) == digest:
-            return read_timeseries(path), runs[runs["file"] == chosen]
-    raise h5io.FileFormatError(f"{chosen}: none of the {LEVER} inputs is the time series it was made from")
+    artifact = next(item for item in events if str(item) == chosen)
+    if artifact.parent is None:
+        raise h5io.FileFormatError(f"{chosen}: given without the time series it was made from (its lineage)")
+    return read_timeseries(artifact.parent), runs[runs["file"] == chosen]
 
 
 def excerpt(record, t_from, duration):

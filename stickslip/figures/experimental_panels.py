@@ -13,7 +13,7 @@ from ..experiment import aging, kinematics
 from .plotting import a_style, individual_style, n_style, plot_density
 from .style import interface_color
 
-__all__ = ["LABELS", "single_slips", "linear_edges", "log_edges", "distributions_by_n", "aging_panel",
+__all__ = ["LABELS", "single_slips", "distributions_by_n", "aging_panel",
            "disorder_law_lines", "slow_slip_fraction_panel", "positions_panel"]
 
 #: Axis labels of the slip quantities (with units).
@@ -27,25 +27,6 @@ def single_slips(slips, protocol=None):
     if protocol is not None:
         keep &= (slips["protocol"] == protocol).to_numpy()
     return slips[keep]
-
-
-def linear_edges(values, bins=25):
-    """``bins`` equal bins from 0 to the 99.5th percentile of the finite ``values``."""
-    values = np.asarray(values, dtype=float)
-    values = values[np.isfinite(values)]
-    top = np.percentile(values, 99.5) if values.size else 1.0
-    return np.linspace(0.0, top * 1.02 if top > 0 else 1.0, bins + 1)
-
-
-def log_edges(values, per_decade=8):
-    """Logarithmic bins (``per_decade`` per factor 10) that cover the positive finite ``values``."""
-    values = np.asarray(values, dtype=float)
-    values = values[np.isfinite(values) & (values > 0)]
-    if not values.size:
-        return np.logspace(0, 1, per_decade + 1)
-    low = np.floor(np.log10(values.min()) * per_decade)
-    high = np.ceil(np.log10(values.max()) * per_decade)
-    return 10.0 ** (np.arange(low, max(high, low + 1) + 1) / per_decade)
 
 
 def distributions_by_n(ax, slips, a, column, edges, *, individual=True, logarithmic=False):

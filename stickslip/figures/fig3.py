@@ -8,9 +8,9 @@ from matplotlib.ticker import NullFormatter
 
 from .. import registry
 from ..params import param
-from .experimental_data import EVENTS, LEVER, example_run, excerpt, load_slips
-from .plotting import a_style, label_panels
-from .experimental_panels import LABELS, distributions_by_n, linear_edges, positions_panel, single_slips
+from .experimental_data import EVENTS, example_run, excerpt, load_slips
+from .plotting import a_style, label_panels, linear_edges
+from .experimental_panels import LABELS, distributions_by_n, positions_panel, single_slips
 from .style import interface_color, plt, save_figure
 
 VERSION = "1"
@@ -43,11 +43,11 @@ def force_panel(ax, record, slips, t_range):
               bbox_to_anchor=(0.08, 1.0))
 
 
-@registry.register("figure", "fig3", VERSION, Fig3Params, inputs=(LEVER, EVENTS))
+@registry.register("figure", "fig3", VERSION, Fig3Params, inputs=(EVENTS,))
 def run(params, inputs, output):
     """Fig. 3: F(t) and R_i(t) excerpt, P(dF) for a = 1 and every n, dR_a measured vs from dF."""
     slips = load_slips(inputs[EVENTS])
-    record, run_slips = example_run(slips, inputs[LEVER], n=params.n_example)
+    record, run_slips = example_run(slips, inputs[EVENTS], n=params.n_example)
     fig = plt.figure(figsize=(8.0, 5.0), layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.5, 1.0))
     ax_F = fig.add_subplot(grid[0, 0])

@@ -5,8 +5,8 @@ import dataclasses
 from .. import registry
 from ..params import param
 from .experimental_data import EVENTS, load_slips
-from .plotting import label_panels
-from .experimental_panels import distributions_by_n, linear_edges, single_slips
+from .plotting import label_panels, linear_edges
+from .experimental_panels import distributions_by_n, single_slips
 from .style import plt, save_figure
 
 VERSION = "1"

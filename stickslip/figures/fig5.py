@@ -8,8 +8,8 @@ import numpy as np
 from .. import registry
 from ..params import param
 from .experimental_data import EVENTS, load_slips
-from .plotting import a_style, label_panels
-from .experimental_panels import LABELS, aging_panel, disorder_law_lines, distributions_by_n, log_edges, single_slips
+from .plotting import a_style, label_panels, log_edges
+from .experimental_panels import LABELS, aging_panel, disorder_law_lines, distributions_by_n, single_slips
 from .style import plt, save_figure
 
 VERSION = "2"

@@ -8,9 +8,9 @@ import numpy as np
 from .. import registry
 from ..experiment.aging import spread_of_aging_rate
 from ..params import param
-from .experimental_data import EVENTS, LEVER, example_run, load_interfaces, load_slips
-from .plotting import a_style, label_panels
-from .experimental_panels import distributions_by_n, linear_edges, single_slips, slow_slip_fraction_panel
+from .experimental_data import EVENTS, example_run, load_interfaces, load_slips
+from .plotting import a_style, label_panels, linear_edges
+from .experimental_panels import distributions_by_n, single_slips, slow_slip_fraction_panel
 from .style import interface_color, plt, save_figure
 
 VERSION = "1"
@@ -67,11 +67,11 @@ def slow_slip_example(ax, record, slips, a, duration):
     ax.legend(fontsize=6.5, frameon=False, loc="lower right")
 
 
-@registry.register("figure", "fig6", VERSION, Fig6Params, inputs=(LEVER, EVENTS))
+@registry.register("figure", "fig6", VERSION, Fig6Params, inputs=(EVENTS,))
 def run(params, inputs, output):
     """Fig. 6: P(B_a) for a = 1, std(B_a) vs n, slow-slip example, R_slow vs n."""
     slips = load_slips(inputs[EVENTS])
-    record, run_slips = example_run(slips, inputs[LEVER], n=params.n_example)
+    record, run_slips = example_run(slips, inputs[EVENTS], n=params.n_example)
     fig, axes = plt.subplots(2, 2, figsize=(7.0, 5.4), layout="constrained")
     one = single_slips(slips, "stack")
     edges = linear_edges(one.loc[one["a"] == 1, "B_a"], params.bins)

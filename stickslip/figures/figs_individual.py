@@ -9,8 +9,8 @@ from matplotlib.ticker import NullFormatter
 from .. import registry
 from ..params import param
 from .experimental_data import EVENTS, load_slips
-from .plotting import a_style, label_panels, plot_density
-from .experimental_panels import LABELS, linear_edges, single_slips
+from .plotting import a_style, label_panels, linear_edges, plot_density
+from .experimental_panels import LABELS, single_slips
 from .style import plt, save_figure
 
 VERSION = "1"

@@ -5,7 +5,8 @@ import dataclasses
 from .. import registry
 from ..params import param
 from .experimental_data import EVENTS, load_slips
-from .experimental_panels import distributions_by_n, linear_edges, log_edges, single_slips
+from .experimental_panels import distributions_by_n, single_slips
+from .plotting import linear_edges, log_edges
 from .style import plt, save_figure
 
 VERSION = "1"

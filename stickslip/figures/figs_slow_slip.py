@@ -8,7 +8,7 @@ import numpy as np
 from .. import registry
 from ..experiment import detection
 from ..params import param
-from .experimental_data import EVENTS, LEVER, example_run, excerpt, load_interfaces, load_slips
+from .experimental_data import EVENTS, example_run, excerpt, load_interfaces, load_slips
 from .plotting import label_panels
 from .experimental_panels import positions_panel, slow_slip_fraction_panel
 from .style import interface_color, plt, save_figure
@@ -34,10 +34,10 @@ def _slip_frames(slips, n_frames, a):
     return inside
 
 
-@registry.register("figure", "figS-slow-slip", VERSION, FigsSlowSlipParams, inputs=(LEVER, EVENTS))
+@registry.register("figure", "figS-slow-slip", VERSION, FigsSlowSlipParams, inputs=(EVENTS,))
 def run(params, inputs, output):
     """SI slow slip: R_i(t) with detected slip frames, smoothed velocities and threshold, R_slow vs n."""
-    record, _ = example_run(load_slips(inputs[EVENTS]), inputs[LEVER], n=params.n_example)
+    record, _ = example_run(load_slips(inputs[EVENTS]), inputs[EVENTS], n=params.n_example)
     t_range = excerpt(record, params.t_from, params.duration)
     # Detection re-run on the record (same defaults as the analysis) to mark frames and velocities.
     slips = detection.detect_slips(record.t_x, record.R)

@@ -10,15 +10,80 @@ refinement rows.
 import dataclasses
 
 import numpy as np
+from matplotlib.collections import PolyCollection
 
 from ..h5io import FileFormatError, open_file
 from ..mesh import read_mesh, read_mesh_params
-from ..mesh.plot import plot_mesh
 from ..params import param
 from ..registry import register
-from .style import plt, save_figure
+from .style import interface_color, plt, save_figure
 
-__all__ = ["MeshFigureParams", "select_mesh", "figure_mesh"]
+__all__ = ["MeshFigureParams", "layer_colors", "plot_mesh", "select_mesh", "figure_mesh"]
+
+
+def layer_colors(mesh):
+    """Default fill colour of every layer, as in the paper's figures.
+
+    The bottom plate (fixed, not driven) is grey, plate ``i >= 1`` has the colour
+    of slab ``i`` (:func:`.style.interface_color`), interfaces
+    are dark.
+
+    Parameters
+    ----------
+    mesh : LayeredMesh
+
+    Returns
+    -------
+    list
+        nlayer matplotlib colours.
+    """
+    colors = []
+    for layer in range(mesh.nlayer):
+        if layer % 2 == 1:
+            colors.append("0.15")
+        elif layer == 0:
+            colors.append("0.7")
+        else:
+            colors.append(interface_color(layer // 2))
+    return colors
+
+
+def plot_mesh(mesh, ax, *, colors=None, edge_width=0.2, edge_color="k", mark_fixed=True):
+    """Draw every element of a mesh, filled by layer.
+
+    Parameters
+    ----------
+    mesh : LayeredMesh
+    ax : matplotlib.axes.Axes
+    colors : Sequence, optional
+        One fill colour per layer (nlayer); default :func:`layer_colors`.
+    edge_width : float, optional
+        Element edge line width [pt]; 0 draws no edges.
+    edge_color : optional
+        Element edge colour.
+    mark_fixed : bool, optional
+        Mark the bottom-edge nodes (both displacement components prescribed).
+
+    Returns
+    -------
+    matplotlib.collections.PolyCollection
+        The elements, in element order.
+    """
+    colors = layer_colors(mesh) if colors is None else list(colors)
+    if len(colors) != mesh.nlayer:
+        raise ValueError(f"colors: expected one colour per layer ({mesh.nlayer}), got {len(colors)}")
+    fills = [colors[layer] for layer in mesh.elem_layer]
+    elements = PolyCollection(mesh.coor[mesh.conn], facecolors=fills, edgecolors=edge_color,
+                              linewidths=edge_width)
+    ax.add_collection(elements)
+    if mark_fixed:
+        bottom = np.flatnonzero(mesh.coor[:, 1] == 0.0)
+        ax.plot(mesh.coor[bottom, 0], mesh.coor[bottom, 1], ls="none", marker="^", ms=3, color="k",
+                clip_on=False, label="fixed nodes")
+    ax.set_xlim(0.0, mesh.length)
+    ax.set_ylim(0.0, mesh.height)
+    ax.set_aspect("equal")
+    return elements
 
 
 @dataclasses.dataclass(frozen=True)
@@ -139,8 +204,8 @@ def _draw_zoom(zoom, full, mesh, width):
     full.add_patch(plt.Rectangle((0.0, bottom), width, top - bottom, fill=False, edgecolor="r", lw=0.8))
 
 
-@register("figure", "figS-mesh", "1", MeshFigureParams, inputs=("mesh",))
+@register("figure", "figS-mesh", "1", MeshFigureParams, inputs=("format:mesh",))
 def run(params, inputs, output):
     """SI figure: the finite-element mesh of the numerical model, coloured per layer."""
-    mesh = read_mesh(select_mesh(inputs.get("mesh", []), params))
+    mesh = read_mesh(select_mesh(inputs.get("format:mesh", []), params))
     save_figure(figure_mesh(mesh, params.zoom_width), output)

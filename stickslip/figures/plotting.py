@@ -1,12 +1,13 @@
-"""Plot helpers shared by every figure: probability densities, bins, the style of ``n`` and
-``a``, and panel letters.
+"""Plot helpers shared by every figure: the bins (one place: :func:`range_edges`,
+:func:`linear_edges`, :func:`log_edges`), probability densities, the style of ``n`` and ``a``,
+and panel letters.
 """
 
 import numpy as np
 
 from .style import N_MARKERS, interface_color, n_color
 
-__all__ = ["density", "plot_density", "range_edges", "n_style", "individual_style", "a_style", "label_panels"]
+__all__ = ["density", "plot_density", "range_edges", "linear_edges", "log_edges", "n_style", "individual_style", "a_style", "label_panels"]
 
 
 def range_edges(values, bins):
@@ -29,6 +30,25 @@ def range_edges(values, bins):
     if high == low:
         low, high = low - 0.5, high + 0.5
     return np.linspace(low, high, bins + 1)
+
+
+def linear_edges(values, bins=25):
+    """``bins`` equal bins from 0 to the 99.5th percentile of the finite ``values``."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    top = np.percentile(values, 99.5) if values.size else 1.0
+    return np.linspace(0.0, top * 1.02 if top > 0 else 1.0, bins + 1)
+
+
+def log_edges(values, per_decade=8):
+    """Logarithmic bins (``per_decade`` per factor 10) that cover the positive finite ``values``."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values) & (values > 0)]
+    if not values.size:
+        return np.logspace(0, 1, per_decade + 1)
+    low = np.floor(np.log10(values.min()) * per_decade)
+    high = np.ceil(np.log10(values.max()) * per_decade)
+    return 10.0 ** (np.arange(low, max(high, low + 1) + 1) / per_decade)
 
 
 def density(values, edges):

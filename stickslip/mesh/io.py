@@ -6,18 +6,18 @@ Layout of a mesh group: datasets ``coor`` [nnode, 2], ``conn`` [nelem, 4],
 ``plates``, ``h`` (the :class:`MeshParams`) and ``mesh_format``.
 """
 
-import hashlib
-import json
 from pathlib import Path
 
+from .. import formats
 from ..h5io import FileFormatError, atomic_output, open_file, write_attrs, write_dataset
+from ..hashing import short_hash
 from ..params import ParameterError, params_to_dict, parse_params
 from .layered import LayeredMesh, MeshParams, build_stack_mesh
 
 __all__ = ["MESH_FORMAT", "mesh_id", "save_mesh", "load_mesh", "read_mesh_params", "write_mesh", "read_mesh"]
 
-#: Version of the mesh geometry and file layout; part of every mesh id.
-MESH_FORMAT = 1
+#: Version of the mesh geometry and file layout (format ``mesh``); part of every mesh id.
+MESH_FORMAT = formats.get_format("mesh").version
 
 _DATASETS = {"coor": 2, "conn": 2, "dofs": 2, "iip": 1, "elem_layer": 1, "layer_y": 2, "interface_elements": 2}
 
@@ -34,9 +34,7 @@ def mesh_id(params):
     str
         16 hexadecimal characters (file name ``results/{study}/mesh/{mesh_id}.h5``).
     """
-    payload = {"mesh_format": MESH_FORMAT, "params": params_to_dict(params)}
-    text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return short_hash({"mesh_format": MESH_FORMAT, "params": params_to_dict(params)})
 
 
 def save_mesh(mesh, group):
@@ -110,11 +108,12 @@ def write_mesh(params, output):
     ----------
     params : MeshParams
     output : str or pathlib.Path
-        The mesh is in the root group; attribute ``mesh_id`` holds :func:`mesh_id`.
+        The mesh is in the root group (format ``mesh``); attribute ``mesh_id`` holds :func:`mesh_id`.
     """
     mesh = build_stack_mesh(params)
     with atomic_output(Path(output)) as tmp:
         with open_file(tmp, "w") as file:
+            formats.stamp(file, "mesh")
             save_mesh(mesh, file)
             write_attrs(file, {"mesh_id": mesh_id(params)})
 
@@ -129,6 +128,12 @@ def read_mesh(path):
     Returns
     -------
     LayeredMesh
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not a ``mesh`` file of the current version.
     """
     with open_file(path) as file:
+        formats.check(file, "mesh")
         return load_mesh(file)

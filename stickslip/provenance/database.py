@@ -25,8 +25,10 @@ from ..h5io import FileFormatError
 __all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "Artifact", "Simulation", "SlipEvent", "Figure",
            "VIEWS", "engine_for", "create_schema"]
 
-#: Version of the table layout; a database of another version must be rebuilt.
-SCHEMA_VERSION = 2
+#: Version of the table layout; a database of another version must be rebuilt (``stickslip db
+#: rebuild``). 2: ``simulations.phi``; 3: lineage (``artifacts.format``, ``artifacts.made_by``,
+#: ``simulations.format``), ``slip_events`` is the ``event-table`` file's table as it is.
+SCHEMA_VERSION = 3
 
 
 class Base(DeclarativeBase):
@@ -76,10 +78,13 @@ class Artifact(Base):
     id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
     run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), index=True)
     direction: Mapped[str] = mapped_column(String, doc="input or output")
-    role: Mapped[str] = mapped_column(String, doc="output, pdf, png, mesh, solver:<name>, analysis:<name>")
+    role: Mapped[str] = mapped_column(String, doc="output, pdf, png, mesh, simulation, analysis:<name>, ...")
     path: Mapped[str] = mapped_column(String, index=True)
     sha256: Mapped[str] = mapped_column(String(64), index=True)
     bytes: Mapped[int] = mapped_column(Integer)
+    format: Mapped[str | None] = mapped_column(String, doc="the file's format (stickslip.formats)")
+    made_by: Mapped[str | None] = mapped_column(String(16), index=True,
+                                                doc="inputs: run id of the job that wrote the file (lineage)")
 
 
 class Simulation(Base):
@@ -89,7 +94,8 @@ class Simulation(Base):
     run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), primary_key=True)
     solver: Mapped[str] = mapped_column(String, index=True)
     path: Mapped[str] = mapped_column(String, doc="the simulation HDF5 file")
-    source: Mapped[str] = mapped_column(String, doc="experimental (lab time-series format) or numerical")
+    format: Mapped[str] = mapped_column(String, doc="its format: fem-run, timeseries, ...")
+    source: Mapped[str | None] = mapped_column(String, doc="experimental or numerical: the format's source")
     protocol: Mapped[str | None] = mapped_column(String, doc="stack or individual (lever)")
     n: Mapped[int | None] = mapped_column(Integer, index=True, doc="number of driven interfaces / slabs")
     a: Mapped[int | None] = mapped_column(Integer, doc="slab driven alone (individual protocol)")
@@ -104,22 +110,21 @@ class Simulation(Base):
 
 
 class SlipEvent(Base):
-    """The slip of one interface in one event, from an analysis output's event table.
+    """The slip of one interface in one event: a row of an ``event-table`` file's ``slip_events`` table.
 
-    Numerical events come from the ``slip_interfaces`` table of ``numerical-events``,
-    experimental ones from the ``slips`` table of ``experiment-events``.
+    Numerical events come from ``numerical-events``, experimental ones from
+    ``experiment-events``; any analysis that produces the format adds its own.
     """
 
     __tablename__ = "slip_events"
     id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
     analysis_run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), index=True)
     simulation_run_id: Mapped[str] = mapped_column(String(16), index=True,
-                                                   doc="run id of the analysed simulation: the stem of its "
-                                                       "path results/sim/{solver}/{run_id}.h5")
+                                                   doc="run id of the analysed simulation (from the lineage)")
     analysis: Mapped[str] = mapped_column(String, index=True)
     solver: Mapped[str] = mapped_column(String, index=True)
     source: Mapped[str | None] = mapped_column(String, index=True,
-                                               doc="numerical or experimental (NULL until its simulation is in)")
+                                               doc="numerical or experimental: the simulation format's source")
     event: Mapped[int] = mapped_column(Integer, doc="event index within the run")
     interface: Mapped[int | None] = mapped_column(Integer, index=True, doc="interface (slab) a, 1 = lowest")
     slip: Mapped[float | None] = mapped_column(Float, doc="slip dR of the interface (experimental) [mm]")
@@ -128,7 +133,7 @@ class SlipEvent(Base):
     multi: Mapped[bool | None] = mapped_column(Boolean, doc="more than one interface slipped in the event")
     time: Mapped[float | None] = mapped_column(Float, doc="time of the slip (experimental) [s]")
     increment: Mapped[int | None] = mapped_column(Integer, doc="increment of the event (numerical)")
-    extra: Mapped[str | None] = mapped_column(Text, doc="the table's other columns, JSON")
+    extra: Mapped[str | None] = mapped_column(Text, doc="the table's further columns, JSON")
 
 
 class Figure(Base):

@@ -7,11 +7,14 @@ record went in, so an interrupted or failed ingest leaves the previous database
 intact. A lock file beside the database serialises concurrent ingests, so two
 processes ingesting at once lose no record.
 
-What goes where (see :mod:`.database`):
+What goes where (see :mod:`.database`); ingest reads formats and the lineage the records
+carry, never file names, and needs no edit for a new solver or analysis:
 
-- every record -> ``runs`` and ``artifacts``;
-- solver records -> ``simulations`` (typed columns from the parameters);
-- analysis records -> ``slip_events``, from the output's event table (:data:`EVENT_TABLES`);
+- every record -> ``runs`` and ``artifacts`` (with each file's format and the run that made it);
+- solver records -> ``simulations``: the source of the output's format and the columns its
+  format describes (:func:`stickslip.formats.describe`);
+- analysis records whose output is an ``event-table`` -> ``slip_events``, the file's
+  ``slip_events`` table as it is, keyed by the simulation named in the record's lineage;
 - figure records -> ``figures``.
 """
 
@@ -23,38 +26,17 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-from sqlalchemy import delete, insert, text
+from sqlalchemy import delete, insert
 from sqlalchemy.orm import Session
 
-from ..h5io import open_file, read_table
+from .. import formats, registry
+from ..formats import event_table
+from ..h5io import FileFormatError
 from ..progress import iterate
 from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
 
-__all__ = ["ingest", "find_records", "EVENT_TABLES", "EVENT_COLUMNS"]
-
-#: Tables of an analysis output read into ``slip_events``, the first found: one row per
-#: (event, slipping interface). Numerical: ``slip_interfaces`` (events.plugin); experimental:
-#: ``slips`` (experiment.analysis).
-EVENT_TABLES = ("slip_interfaces", "slips")
-
-#: Column of an event table -> column of ``slip_events``; the table's other columns go to ``extra``.
-EVENT_COLUMNS = {"event": "event", "a": "interface", "dR": "slip", "dmu": "dmu", "t": "time",
-                 "increment": "increment", "multi": "multi"}
-
-#: Column of ``simulations`` -> names it comes from, first found: a parameter of the run, else a
-#: root attribute of the simulation file (fem runs have ``plates``; their files say ``n_interfaces``).
-SIMULATION_COLUMNS = {"protocol": ("protocol",), "n": ("n", "n_interfaces"), "a": ("a",), "plates": ("plates",),
-                      "blocks": ("N",), "k_drive": ("k_drive",), "phi": ("phi",),
-                      "regime": ("regime",), "seed": ("seed",)}
-
-#: A simulation's driving regime, when its parameters do not state it, is the one its analysis
-#: output states (numerical-events: from k_drive); set once both records are in the same ingest.
-REGIME_FROM_ANALYSES = "UPDATE simulations SET regime = :regime WHERE run_id = :run_id AND regime IS NULL"
-
-#: An event's source is its simulation's (known once both records are in).
-SOURCE_FROM_SIMULATIONS = ("UPDATE slip_events SET source = (SELECT s.source FROM simulations AS s "
-                           "WHERE s.run_id = slip_events.simulation_run_id) WHERE source IS NULL")
+__all__ = ["ingest", "find_records"]
 
 
 def find_records(results):
@@ -109,21 +91,25 @@ def _run_row(record, record_file):
 
 def _artifact_rows(record):
     return [{"run_id": record["run_id"], "direction": direction, "role": entry["role"], "path": entry["path"],
-             "sha256": entry["sha256"], "bytes": entry["bytes"]}
+             "sha256": entry["sha256"], "bytes": entry["bytes"], "format": entry.get("format"),
+             "made_by": entry.get("run_id")}
             for direction, key in (("input", "inputs"), ("output", "outputs")) for entry in record[key]]
 
 
+def _format(name, where):
+    try:
+        return formats.get_format(name)
+    except formats.FormatError as error:
+        raise FileFormatError(f"{where}: {error} (is the plugin that writes it installed?)") from None
+
+
 def _simulation_row(record, record_file):
-    """Typed columns from the parameters, else from the simulation file's root attributes."""
-    path = record["outputs"][0]["path"]
-    with open_file(_beside(record_file, path)) as handle:
-        attrs = {key: _python(value) for key, value in handle.attrs.items()}
-        source = "experimental" if "t_F" in handle else "numerical"
-    row = {"run_id": record["run_id"], "solver": record["plugin"], "path": path, "source": source}
-    for column, names in SIMULATION_COLUMNS.items():
-        found = [source[name] for name in names for source in (record["params"], attrs) if name in source]
-        value = found[0] if found else None
-        row[column] = value.decode() if isinstance(value, bytes) else value
+    """The output's format: its source, and the columns it describes."""
+    output = record["outputs"][0]
+    fmt = _format(output["format"], record_file)
+    row = {"run_id": record["run_id"], "solver": record["plugin"], "path": output["path"], "format": fmt.name,
+           "source": fmt.source}
+    row.update(formats.describe(fmt.name, _beside(record_file, output["path"])))
     return row
 
 
@@ -134,31 +120,20 @@ def _python(value):
 
 
 def _event_rows(record, record_file):
-    """Rows of ``slip_events`` from an analysis output, and the output's ``regime`` attribute (or None)."""
-    output = _beside(record_file, record["outputs"][0]["path"])
-    with open_file(output) as handle:
-        regime = _python(handle.attrs.get("regime"))
-        name = next((table for table in EVENT_TABLES if table in handle), None)
-        if name is None:
-            return [], regime
-        table = read_table(handle, name)
-    if "single" in table.columns and "multi" not in table.columns:
-        table["multi"] = ~table.pop("single").astype(bool)
-    if "event" not in table.columns and "increment" in table.columns:
-        table.insert(0, "event", table["increment"].rank(method="dense").astype(int) - 1)
-    simulation = record["inputs"][0]
-    identity = {"analysis_run_id": record["run_id"], "simulation_run_id": Path(simulation["path"]).stem,
-                "analysis": record["plugin"], "solver": simulation["role"].partition(":")[2], "source": None}
-    extra_columns = [c for c in table.columns if c not in EVENT_COLUMNS]
-    rows = []
-    for index, item in enumerate(table.to_dict("records")):
-        row = dict(identity)
-        row.update({column: _python(item.get(name)) for name, column in EVENT_COLUMNS.items()})
-        if row["event"] is None:
-            row["event"] = index
-        row["extra"] = json.dumps({c: _python(item[c]) for c in extra_columns}) if extra_columns else None
-        rows.append(row)
-    return rows, regime
+    """Rows of ``slip_events``: an ``event-table`` output's table, keyed by the record's lineage."""
+    output = record["outputs"][0]
+    if output.get("format") != event_table.FORMAT:
+        return []
+    table = event_table.read_slip_events(_beside(record_file, output["path"]))
+    simulation = next(entry for entry in record["inputs"] if entry["role"] == "simulation")
+    identity = {"analysis_run_id": record["run_id"], "simulation_run_id": simulation["run_id"],
+                "analysis": record["plugin"], "solver": simulation["plugin"],
+                "source": _format(simulation["format"], record_file).source}
+    standard = [c for c in table.columns if c in event_table.COLUMNS]
+    further = [c for c in table.columns if c not in event_table.COLUMNS]
+    return [{**identity, **{c: _python(row[c]) for c in standard},
+             "extra": json.dumps({c: _python(row[c]) for c in further}) if further else None}
+            for row in table.to_dict("records")]
 
 
 def _figure_row(record):
@@ -168,13 +143,7 @@ def _figure_row(record):
 
 
 def _ingest_record(session, record, record_file):
-    """Replace the rows of one run by those of its record.
-
-    Returns
-    -------
-    tuple[int, dict[str, str]]
-        Slip events added; simulation run id -> driving regime stated by an analysis output.
-    """
+    """Replace the rows of one run by those of its record; return the number of slip events added."""
     run_id = record["run_id"]
     for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (Artifact, Artifact.run_id),
                        (Simulation, Simulation.run_id), (Figure, Figure.run_id), (Run, Run.run_id)):
@@ -183,18 +152,16 @@ def _ingest_record(session, record, record_file):
     artifacts = _artifact_rows(record)
     if artifacts:
         session.execute(insert(Artifact), artifacts)
-    events, regimes = [], {}
+    events = []
     if record["kind"] == "solver":
         session.execute(insert(Simulation), [_simulation_row(record, record_file)])
     elif record["kind"] == "analysis":
-        events, regime = _event_rows(record, record_file)
+        events = _event_rows(record, record_file)
         if events:
             session.execute(insert(SlipEvent), events)
-        if regime is not None:
-            regimes[Path(record["inputs"][0]["path"]).stem] = regime
     elif record["kind"] == "figure":
         session.execute(insert(Figure), [_figure_row(record)])
-    return len(events), regimes
+    return len(events)
 
 
 def ingest(database, records, *, rebuild=False):
@@ -223,10 +190,12 @@ def ingest(database, records, *, rebuild=False):
 
     Notes
     -----
-    Cost: reads every record and every analysis output's ``slips`` table; the
-    database is copied once (its size) unless ``rebuild``.
+    Cost: reads every record, the header of every simulation and every ``slip_events``
+    table; the database is copied once (its size) unless ``rebuild``.
     """
     from .. import __version__
+
+    registry.available("solver")  # plugins register the formats they write
 
     database = Path(database)
     database.parent.mkdir(parents=True, exist_ok=True)
@@ -245,15 +214,8 @@ def ingest(database, records, *, rebuild=False):
                 create_schema(engine, __version__)
                 events = 0
                 with Session(engine) as session, session.begin():
-                    regimes = {}
                     for record_file in iterate(records, desc="ingest", unit="record"):
-                        added, found = _ingest_record(session, read_record(record_file), record_file)
-                        events += added
-                        regimes.update(found)
-                    session.execute(text(SOURCE_FROM_SIMULATIONS))
-                    if regimes:
-                        session.execute(text(REGIME_FROM_ANALYSES),
-                                        [{"run_id": k, "regime": v} for k, v in regimes.items()])
+                        events += _ingest_record(session, read_record(record_file), record_file)
             finally:
                 engine.dispose()
             os.replace(tmp, database)

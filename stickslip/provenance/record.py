@@ -11,7 +11,6 @@ The record of ``results/default/sim/lever/0123456789abcdef.h5`` is
 """
 
 import datetime
-import hashlib
 import json
 import platform
 import resource
@@ -24,12 +23,15 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 from ..h5io import FileFormatError, atomic_output
+from ..hashing import sha256_file
+from ..lineage import Artifact
 
-__all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "sha256_file", "file_entry", "git_state",
+__all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "file_entry", "git_state",
            "library_versions", "peak_memory_mib", "write_record", "read_record", "recording"]
 
-#: Version of the record layout; bump when fields change meaning.
-SCHEMA_VERSION = 1
+#: Version of the record layout; bump when fields change meaning. 2: file entries carry lineage
+#: (``format``; inputs also ``run_id``, ``plugin`` and ``parent`` of the job that made them).
+SCHEMA_VERSION = 2
 
 #: Fields every record has (values may be null where not applicable, e.g. ``seed``).
 REQUIRED_FIELDS = ("schema_version", "run_id", "kind", "plugin", "plugin_version", "code_hash",
@@ -37,8 +39,6 @@ REQUIRED_FIELDS = ("schema_version", "run_id", "kind", "plugin", "plugin_version
                    "versions", "host", "start", "end", "wall_time_s", "peak_memory_mib", "inputs", "outputs")
 
 LIBRARIES = ("numpy", "numba", "h5py", "pandas", "matplotlib", "sqlalchemy", "snakemake")
-
-_CHUNK = 1 << 20
 
 
 def record_path(output):
@@ -55,38 +55,38 @@ def record_path(output):
     return Path(output).with_suffix(".provenance.json")
 
 
-def sha256_file(path):
-    """Return the sha256 (hex) of a file's bytes, read in 1 MiB chunks."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        while chunk := stream.read(_CHUNK):
-            digest.update(chunk)
-    return digest.hexdigest()
-
-
-def file_entry(role, path):
+def file_entry(role, path, **lineage):
     """Describe one input or output file.
 
     Parameters
     ----------
     role : str
-        What the file is to the job (``"output"``, ``"mesh"``, ``"solver:lever"``, ...).
-    path : str or pathlib.Path
+        What the file is to the job (``"output"``, ``"mesh"``, ``"simulation"``,
+        ``"analysis:experiment-events"``, ...).
+    path : str or os.PathLike
+        A :class:`stickslip.lineage.Artifact` adds its lineage: ``run_id``, ``plugin``,
+        ``format`` and ``parent`` (the parent's run id).
+    **lineage
+        Further fields, e.g. ``format`` of an output.
 
     Returns
     -------
     dict
-        ``{"role", "path", "sha256", "bytes"}``.
+        ``{"role", "path", "sha256", "bytes"}`` and the lineage fields.
 
     Raises
     ------
     FileFormatError
         If the file does not exist.
     """
+    if isinstance(path, Artifact):
+        lineage = {"run_id": path.run_id, "plugin": path.plugin, "format": path.format,
+                   **({} if path.parent is None else {"parent": path.parent.run_id}), **lineage}
     path = Path(path)
     if not path.is_file():
         raise FileFormatError(f"{path}: no such file (expected as {role})")
-    return {"role": role, "path": path.as_posix(), "sha256": sha256_file(path), "bytes": path.stat().st_size}
+    return {"role": role, "path": path.as_posix(), "sha256": sha256_file(path), "bytes": path.stat().st_size,
+            **lineage}
 
 
 def git_state(directory=None):
@@ -216,12 +216,14 @@ def recording(record_file, outputs, **identity):
     ----------
     record_file : str or pathlib.Path
         Where the record goes (see :func:`record_path`).
-    outputs : Sequence[tuple[str, str | pathlib.Path]]
-        ``(role, path)`` of each file the job writes; hashed after the job.
+    outputs : Sequence[tuple]
+        ``(role, path)`` or ``(role, path, format)`` of each file the job writes; hashed
+        after the job.
     **identity
         ``run_id``, ``kind``, ``plugin``, ``plugin_version``, ``code_hash``,
         ``params`` (dict), and optionally ``threads`` (int) and ``inputs``
-        (sequence of ``(role, path)``).
+        (sequence of ``(role, path)``; a :class:`stickslip.lineage.Artifact` as path
+        records its lineage).
 
     Yields
     ------
@@ -235,7 +237,7 @@ def recording(record_file, outputs, **identity):
     outputs' directories are created.
     """
     record = _job_record(**identity)
-    for _, path in outputs:
+    for _, path, *_ in outputs:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
     start_clock, start = time.perf_counter(), _now()
     yield record
@@ -243,6 +245,6 @@ def recording(record_file, outputs, **identity):
     record.update({
         "start": start, "end": _now(), "wall_time_s": round(wall, 6),
         "peak_memory_mib": round(peak_memory_mib(), 3),
-        "outputs": [file_entry(role, path) for role, path in outputs],
+        "outputs": [file_entry(role, path, **({"format": rest[0]} if rest else {})) for role, path, *rest in outputs],
     })
     write_record(record_file, record)

@@ -10,6 +10,7 @@ parameters is resumed, a completed one is left as it is.
 
 from .. import registry
 from ..fem.parameters import FemParams
+from ..fem.replay import EventReplay
 from ..fem.run import run_simulation
 from ..h5io import FileFormatError
 from ..mesh import MeshParams, build_stack_mesh, read_mesh
@@ -31,7 +32,7 @@ def _mesh(params, inputs):
     return mesh
 
 
-@registry.register("solver", "fem", VERSION, FemParams, inputs=("mesh",))
+@registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads=1, inputs=None):
     """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
-    run_simulation(params, output, _mesh(params, inputs), threads=threads)
+    run_simulation(params, output, _mesh(params, inputs), threads=threads, producer=("fem", VERSION))

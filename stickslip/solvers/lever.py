@@ -182,7 +182,7 @@ def simulate(params):
     return signals, history.slips, _interfaces_table(lever, law, history)
 
 
-@registry.register("solver", "lever", VERSION, LeverParams,
+@registry.register("solver", "lever", VERSION, LeverParams, produces="timeseries",
                    summary="virtual lever experiment (aging, disorder, creep) written as a lab time series")
 def run(params, output, *, threads, inputs):
     """Run one virtual experiment and write its time-series file with the ground truth."""

@@ -154,7 +154,7 @@ def simulate(params):
     return signals, truth, interfaces, t.size - 1
 
 
-@registry.register("solver", "rate-state-lever", VERSION, RateStateLeverParams,
+@registry.register("solver", "rate-state-lever", VERSION, RateStateLeverParams, produces="timeseries",
                    summary="virtual lever experiment with inertial slabs on rate-and-state (aging law) interfaces")
 def run(params, output, *, threads, inputs):
     """Run one rate-and-state virtual experiment and write its time-series file with the ground truth."""

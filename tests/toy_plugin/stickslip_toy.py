@@ -10,8 +10,9 @@ dynamic equilibrium, of amplitude ``2 (F_threshold - F_d) / k``; the moving
 drive adds a small correction, known in closed form (:func:`slip_amplitude`),
 which the tests compare with the integrated slips.
 
-Registered kinds: solver ``toy-spring-block``, analysis ``toy-slips``, figure
-``toy-force``. The test suite installs this module with a distribution whose
+Registered kinds: format ``toy-block`` (the solver's output), solver
+``toy-spring-block``, analysis ``toy-slips`` (it produces the package's ``event-table``
+format, so the results database ingests its slips with no edit), figure ``toy-force``. The test suite installs this module with a distribution whose
 ``entry_points.txt`` names it in the groups ``stickslip.solvers``,
 ``stickslip.analyses`` and ``stickslip.figures``.
 """
@@ -22,10 +23,22 @@ import math
 import numpy as np
 import pandas as pd
 
-from stickslip import h5io
+from stickslip import formats, h5io
 from stickslip.figures.style import plt, save_figure
+from stickslip.formats.analysis_file import write_analysis_file
+from stickslip.formats.event_table import read_slip_events, slip_events_table
 from stickslip.params import param
 from stickslip.registry import register
+
+formats.register_format(formats.Format("toy-block", 1, __name__, "a spring-block history: t [s], x [mm], F [N]",
+                                       source="numerical", describe=f"{__name__}:describe"))
+
+
+def describe(path):
+    """The database's simulation columns of a toy-block file: its seed."""
+    with h5io.open_file(path) as file:
+        formats.check(file, "toy-block")
+        return {"seed": int(file.attrs["seed"])}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -101,11 +114,12 @@ def simulate(params):
     return times, positions, params.k * (params.V * times - positions)
 
 
-@register("solver", "toy-spring-block", "1", BlockParams)
+@register("solver", "toy-spring-block", "1", BlockParams, produces="toy-block")
 def run_solver(params, output, *, threads, inputs):
     """Spring-block slider with random static thresholds (test plugin)."""
     t, x, F = simulate(params)
     with h5io.open_file(output, "w") as file:
+        formats.stamp(file, "toy-block")
         h5io.write_dataset(file, "t", t)
         h5io.write_dataset(file, "x", x)
         h5io.write_dataset(file, "F", F)
@@ -120,20 +134,21 @@ class SlipParams:
     threshold: float = param(1e-3, "smallest slip", unit="mm", exclusive_minimum=0)
 
 
-@register("analysis", "toy-slips", "1", SlipParams, inputs=("toy-spring-block",))
+@register("analysis", "toy-slips", "1", SlipParams, consumes=("toy-block",), produces="event-table")
 def run_analysis(params, input, output):
     """Slips of a spring-block run: one row per slip (test plugin)."""
     with h5io.open_file(input) as file:
+        formats.check(file, "toy-block")
         t, x = file["t"][...], file["x"][...]
     moving = np.diff(x) > 0
     starts = np.flatnonzero(moving & ~np.r_[False, moving[:-1]])
     ends = np.flatnonzero(moving & ~np.r_[moving[1:], False]) + 1
     dR = x[ends] - x[starts]
     keep = dR >= params.threshold
-    table = pd.DataFrame({"event": np.arange(keep.sum()), "a": np.ones(keep.sum(), dtype=np.int64),
-                          "t": t[starts][keep], "dR": dR[keep]})
-    with h5io.open_file(output, "w") as file:
-        h5io.write_table(file, "slips", table)
+    table = pd.DataFrame({"event": np.arange(keep.sum()), "interface": np.ones(keep.sum(), dtype=np.int64),
+                          "multi": np.zeros(keep.sum(), dtype=bool), "time": t[starts][keep], "slip": dR[keep]})
+    write_analysis_file(output, "event-table", analysis="toy-slips", version="1", params=params, input=input,
+                        attrs={}, tables={"slip_events": slip_events_table(table)})
 
 
 @dataclasses.dataclass(frozen=True)
@@ -143,17 +158,15 @@ class ForceFigureParams:
     width: float = param(4.0, "figure width", unit="inch", exclusive_minimum=0)
 
 
-@register("figure", "toy-force", "1", ForceFigureParams, inputs=("solver:toy-spring-block", "analysis:toy-slips"))
+@register("figure", "toy-force", "1", ForceFigureParams, inputs=("analysis:toy-slips",))
 def run_figure(params, inputs, output):
     """Spring force against time of every spring-block run, slips marked (test plugin)."""
     fig, ax = plt.subplots(figsize=(params.width, 3))
-    for path in inputs["solver:toy-spring-block"]:
-        with h5io.open_file(path) as file:
+    for item in inputs["analysis:toy-slips"]:
+        with h5io.open_file(item.parent) as file:  # the run the slips were found in (lineage)
             ax.plot(file["t"][...], file["F"][...], lw=0.8)
-    for path in inputs["analysis:toy-slips"]:
-        with h5io.open_file(path) as file:
-            slips = h5io.read_table(file, "slips")
-        ax.plot(slips["t"], np.zeros(len(slips)), "k|")
+        slips = read_slip_events(item)
+        ax.plot(slips["time"], np.zeros(len(slips)), "k|")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("F (N)")
     save_figure(fig, output)

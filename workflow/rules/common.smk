@@ -1,7 +1,6 @@
 # The study: the config validated (each plugin section against its plugin's JSON-Schema, defaults
 # filled) and expanded into jobs by stickslip.study before any rule is defined.
 
-import json
 import tempfile
 from pathlib import Path
 

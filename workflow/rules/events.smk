@@ -1,4 +1,5 @@
-# Analyses: one rule for every analysis plugin; the analysis and the solver are path components.
+# Analyses: one rule for every analysis plugin; the analysis and the solver are path components. The job
+# receives the lineage of its simulation (run id, solver, format) from the study, never from the path.
 
 
 rule events:
@@ -11,6 +12,7 @@ rule events:
         STUDY.log("events/{analysis}/{solver}/{run_id}"),
     params:
         params=lambda wildcards: Study.dumps(STUDY.analyses[wildcards.analysis]),
+        simulation=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).artifact()),
         code=lambda wildcards: Study.code("analysis", wildcards.analysis),
     conda:
         CONDA_ENV

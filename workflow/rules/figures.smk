@@ -1,5 +1,6 @@
 # One rule per figure (figure_<name>, "-" as "_"), so that `--forcerun figure_<name>` redraws
-# that figure alone. The caption comes from the figure plugin's summary (report/figure.rst).
+# that figure alone. The caption comes from the figure plugin's summary (report/figure.rst). The job
+# receives its inputs with their lineage: each analysis output paired with its simulation.
 
 for _figure, _job in STUDY.figures.items():
 
@@ -7,7 +8,7 @@ for _figure, _job in STUDY.figures.items():
         name:
             f"figure_{_figure.replace('-', '_')}"
         input:
-            [path for paths in _job.inputs.values() for path in paths],
+            _job.files(),
         output:
             pdf=report(_job.path, caption="../report/figure.rst", category="Figures",
                        labels={"figure": _figure, "format": "PDF"}),
@@ -19,7 +20,7 @@ for _figure, _job in STUDY.figures.items():
         params:
             figure=_figure,
             params=Study.dumps(_job.params),
-            inputs=json.dumps(_job.inputs, sort_keys=True),
+            inputs=Study.dumps(_job.inputs),
             code=Study.code("figure", _figure),
             caption=STUDY.caption(_figure),
         conda:

@@ -1,9 +1,10 @@
-# One rule for every solver: the solver is a wildcard (a path component), chosen in the config.
+# One rule for every solver: the solver is a wildcard (a path component), chosen in the config. The job
+# receives its upstream files (the mesh) with their lineage (params.inputs).
 
 
 rule simulate:
     input:
-        unpack(lambda wildcards: STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
+        unpack(lambda wildcards: {k: str(v) for k, v in STUDY.solver_inputs(wildcards.solver, wildcards.run_id).items()}),
     output:
         h5=STUDY.path("simulation"),
         record=record_of(STUDY.path("simulation")),
@@ -14,6 +15,7 @@ rule simulate:
     threads: STUDY.threads
     params:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
+        inputs=lambda wildcards: Study.dumps(STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
         code=lambda wildcards: Study.code("solver", wildcards.solver),
     conda:
         CONDA_ENV

@@ -2,5 +2,5 @@
 
 from stickslip.workflow_api import run_analysis
 
-run_analysis(snakemake.wildcards.analysis, snakemake.params.params, snakemake.input[0], snakemake.output.h5,
+run_analysis(snakemake.wildcards.analysis, snakemake.params.params, snakemake.params.simulation, snakemake.output.h5,
              snakemake.output.record, snakemake.log[0], numba_cache=snakemake.resources.get("numba_cache", ""))

@@ -1,0 +1,83 @@
+"""Event replay: a stored kick increment of a ``fem`` run redone with every block failure recorded.
+
+The replay is the ``fem`` solver's capability (:func:`stickslip.registry.register`,
+``replay=``): an analysis asks the solver that wrote a file to replay its events. The
+model is built once per run file; each replay restores the stored state before the kick
+and runs the same kick and minimisation as the run (:meth:`.system.System.kick_and_minimise`).
+"""
+
+import numpy as np
+import pandas as pd
+
+from ..h5io import FileFormatError, open_file, read_table
+from .output import RunFile
+from .system import System
+
+__all__ = ["EventReplay"]
+
+
+class EventReplay:
+    """Replays stored kick increments of one run file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``fem-run`` file.
+
+    Notes
+    -----
+    Cost: the file's header and increment table are read, and the model (yield strains,
+    stiffness) built, once; each :meth:`failures` costs one kick and one minimisation.
+    """
+
+    def __init__(self, path):
+        self.path = path
+        with open_file(path) as file:
+            run = RunFile(file)
+            self.params, self.nstored = run.params, run.nstored
+            table = read_table(file, "increments", rows=run.nstored)
+            response = run.linear_response()
+            self.N = run.mesh.N
+            self.system = System(run.params, run.mesh)
+        self._kick = table["kick"].to_numpy(dtype=bool)
+        self._yield_element = table["yield_element"].to_numpy(dtype=bool)
+        self.system.set_linear_response(*response)
+
+    def _state(self, increment):
+        with open_file(self.path) as file:
+            return RunFile(file).state(increment)
+
+    def failures(self, increment):
+        """Redo one kick increment and record every well hop of the interface blocks.
+
+        The state of ``increment - 1`` is restored, the stored kick redone (the whole-element
+        fallback if the run used it), and the result must reproduce the stored increment
+        exactly (asserted).
+
+        Parameters
+        ----------
+        increment : int
+            A stored kick increment (>= 1).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``a`` (interface, 1 = lowest), ``block`` (0 ... N-1), ``t`` (time since the
+            kick [FE time units]), ``direction`` (+1 / -1); one row per well hop, in time order.
+
+        Raises
+        ------
+        FileFormatError
+            If the increment is not a stored kick.
+        """
+        if not 1 <= increment < self.nstored or not self._kick[increment]:
+            raise FileFormatError(f"{self.path}: increment {increment} is not a stored kick increment")
+        before, after = self._state(increment - 1), self._state(increment)
+        self.system.restore(*before)
+        niter, events = self.system.kick_and_minimise(bool(self._yield_element[increment]), self.params.margin,
+                                                      record=True)
+        if niter == 0 or not np.array_equal(self.system.state.u, after[0]) or self.system.state.t[0] != after[3]:
+            raise AssertionError(f"{self.path}: replaying increment {increment} did not reproduce the stored state")
+        element = events[:, 0].astype(np.int64)
+        return pd.DataFrame({"a": element // self.N + 1, "block": element % self.N, "t": events[:, 1] - before[3],
+                             "direction": events[:, 2].astype(np.int64)})
