@@ -131,6 +131,7 @@ def test_ingest_reads_lineage_and_formats_not_paths(tmp_path, toy_plugins, monke
     from stickslip.workflow_api import run_analysis, run_simulation
 
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "1")  # the jobs set it; restored after the test
     solver, analysis = registry.get("solver", "toy-spring-block"), registry.get("analysis", "toy-slips")
     run = registry.run_id(solver, parse_params(solver.params, {"seed": 3, "slips": 3}))
     sim = Artifact("anything/first.h5", run, solver.name, solver.produces)

@@ -1,4 +1,4 @@
-"""``stickslip plugins``: list the registered solvers, analyses and figures."""
+"""``stickslip plugins``: list the registered solvers, analyses and figures, with their contracts."""
 
 from .. import registry
 from ..params import describe
@@ -20,8 +20,12 @@ def run(args):
     for kind in [args.kind] if args.kind else registry.KINDS:
         print(f"{PLURAL[kind]}:")
         for name, plugin in registry.available(kind).items():
-            inputs = f" [inputs: {', '.join(plugin.inputs)}]" if plugin.inputs else ""
-            print(f"  {name} {plugin.version}  {plugin.summary}{inputs}  ({plugin.module})")
+            contract = ([f"consumes {', '.join(plugin.consumes)}"] if plugin.consumes else [])
+            contract += [f"produces {plugin.produces}"] if plugin.produces else []
+            contract += [f"inputs {', '.join(plugin.inputs)}"] if plugin.inputs else []
+            contract += ["replays events"] if plugin.replay else []
+            contract = f" [{'; '.join(contract)}]" if contract else ""
+            print(f"  {name} {plugin.version}  {plugin.summary}{contract}  ({plugin.module})")
             if args.params:
                 for pname, ptype, default, unit, doc in describe(plugin.params):
                     unit = f" [{unit}]" if unit else ""
