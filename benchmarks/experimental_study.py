@@ -21,7 +21,8 @@ import numpy as np
 
 from stickslip import registry
 from stickslip.experiment.aging import fit_aging, spread_of_aging_rate
-from stickslip.figures.experimental_data import EVENTS, LEVER, load_interfaces, load_slips
+from stickslip.figures.experimental_data import EVENTS, load_interfaces, load_slips
+from stickslip.lineage import Artifact
 from stickslip.params import parse_params
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distributions", "figS-aging-variations",
@@ -31,10 +32,13 @@ FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distrib
 def _simulate_and_analyse(job):
     name, values, root = job
     solver, analysis = registry.get("solver", "lever"), registry.get("analysis", "experiment-events")
-    raw, events = root / "raw" / f"{name}.h5", root / "events" / f"{name}.h5"
-    solver.run(parse_params(solver.params, values), raw, threads=1, inputs={})
-    analysis.run(parse_params(analysis.params, {}), raw, events)
-    return raw, events
+    params = parse_params(solver.params, values)
+    raw = Artifact(root / "raw" / f"{name}.h5", registry.run_id(solver, params), solver.name, solver.produces)
+    solver.run(params, raw.path, threads=1, inputs={})
+    run_id = registry.derived_run_id(analysis, analysis.params(), [raw.run_id])
+    events = Artifact(root / "events" / f"{name}.h5", run_id, analysis.name, analysis.produces, raw)
+    analysis.run(parse_params(analysis.params, {}), raw, events.path)
+    return events
 
 
 def _figure(job):
@@ -87,9 +91,9 @@ def main():
              for a in range(1, 6) for s in range(args.runs)]
     start = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
-        pairs = list(pool.map(_simulate_and_analyse, jobs))
+        events = list(pool.map(_simulate_and_analyse, jobs))
         simulated = time.perf_counter()
-        inputs = {LEVER: [raw for raw, _ in pairs], EVENTS: [events for _, events in pairs]}
+        inputs = {EVENTS: events}
         list(pool.map(_figure, [(name, inputs, root) for name in FIGURES]))
     done = time.perf_counter()
     print(f"{len(jobs)} runs simulated and analysed in {simulated - start:.1f} s; {len(FIGURES)} figures in "

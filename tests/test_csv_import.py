@@ -10,7 +10,8 @@ from stickslip.experiment.csv_import import import_csv
 from stickslip.experiment.timeseries import read_timeseries
 from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
-from stickslip.solvers.lever import LeverParams, simulate
+from stickslip.experiment.virtual.model import simulate
+from stickslip.solvers.lever import LeverParams
 
 FORCE = "# exported by the lab\nt [s],F [N]\n0.00,2.5\n0.02,2.6\n0.04,2.7\n"
 POSITIONS = "t [s],x1 [mm],x2 [mm]\n0.0,1.0,2.0\n0.2,1.1,2.3\n"

@@ -42,8 +42,8 @@ def study(tmp_path_factory):
         params = parse_params(solver.params, {**values, "duration": 2500.0})
         raw = Artifact(root / f"raw{index}.h5", registry.run_id(solver, params), solver.name, solver.produces)
         solver.run(params, raw.path, threads=1, inputs={})
-        events = Artifact(root / f"events{index}.h5", registry.derived_run_id(analysis, analysis.params(), [raw.run_id]),
-                          analysis.name, analysis.produces, raw)
+        run_id = registry.derived_run_id(analysis, analysis.params(), [raw.run_id])
+        events = Artifact(root / f"events{index}.h5", run_id, analysis.name, analysis.produces, raw)
         analysis.run(parse_params(analysis.params, {}), raw, events.path)
         inputs[experimental_data.EVENTS].append(events)
     return inputs

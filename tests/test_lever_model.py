@@ -7,7 +7,8 @@ import pytest
 
 from stickslip.experiment.virtual import first_crossing, integrate, relative_positions
 from stickslip.params import parse_params
-from stickslip.solvers.lever import LeverParams, apparatus, friction_law, simulate
+from stickslip.experiment.virtual.model import apparatus, friction_law, simulate
+from stickslip.solvers.lever import LeverParams
 
 K, N, h, H, V = 55.0, 49.0, 10.0, 100.0, 0.01
 

@@ -12,7 +12,8 @@ from stickslip import registry
 from stickslip.cli import main
 from stickslip.experiment.timeseries import read_timeseries, read_truth
 from stickslip.params import ParameterError, parse_params
-from stickslip.solvers.lever import LeverParams, simulate
+from stickslip.experiment.virtual.model import simulate
+from stickslip.solvers.lever import LeverParams
 
 
 def digest(path):

@@ -109,10 +109,11 @@ def test_reader_names_the_bad_item(tmp_path, edit, message):
 def test_a_stack_recording_without_a_is_read_and_analysed(tmp_path):
     """Lab exports of the stack protocol carry no driven-slab attribute: read as a = 0, analysed as with it."""
     from stickslip.cli import main
-    from stickslip.solvers import lever
+    from stickslip.experiment.virtual.model import simulate
+    from stickslip.solvers.lever import LeverParams
 
     with_a, without_a = tmp_path / "with_a.h5", tmp_path / "without_a.h5"
-    signals, _, _ = lever.simulate(lever.LeverParams(n=2, duration=600.0, seed=1))
+    signals, _, _ = simulate(LeverParams(n=2, duration=600.0, seed=1))
     for path in (with_a, without_a):
         write_timeseries(path, signals)
     with h5py.File(without_a, "r+") as f:

@@ -27,6 +27,7 @@ import pandas as pd
 from ..fem.stiffness import PAPER_N, stiffness_ratio
 from ..fem.stiffness import driving_regime as regime_of
 from ..h5io import FileFormatError
+from ..mesh.layered import interface_layer
 
 __all__ = [
     "PAPER_N",
@@ -91,7 +92,7 @@ def interfaces_in(increments):
 def _check_table(increments, interfaces, source):
     required = ["increment", "kick", "gamma", "epsd", "sigd"]
     for a in interfaces:
-        required += [f"S_a{a}", f"A_a{a}", f"sigd_{2 * a - 1}"]
+        required += [f"S_a{a}", f"A_a{a}", f"sigd_{interface_layer(a)}"]
     missing = [c for c in required if c not in increments.columns]
     if missing:
         raise FileFormatError(f"{source}: increment table lacks column(s) {', '.join(missing)}")
@@ -179,7 +180,7 @@ def classify_increments(increments, N, *, source="increment table"):
         out[f"S_a{a}"] = increments[f"S_a{a}"].to_numpy(dtype=np.int64)
         out[f"A_a{a}"] = increments[f"A_a{a}"].to_numpy(dtype=np.int64)
     for a in interfaces:
-        out[f"mu_a{a}"] = increments[f"sigd_{2 * a - 1}"].to_numpy(dtype=float)
+        out[f"mu_a{a}"] = increments[f"sigd_{interface_layer(a)}"].to_numpy(dtype=float)
     s = _slipping(increments, interfaces, N).sum(axis=1)
     out["s"] = s.astype(np.int64)
     kind = np.where(s > 1, "multi", np.where(s == 1, "single", "micro"))

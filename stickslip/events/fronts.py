@@ -29,7 +29,7 @@ from .. import h5io, registry
 from ..formats.analysis_file import write_analysis_file
 from ..h5io import FileFormatError
 from ..lineage import Artifact
-from ..mesh import load_mesh
+from ..mesh import interface_layer, load_mesh
 from ..params import ParameterError, param
 from ..progress import iterate
 from ..registry import register
@@ -191,7 +191,7 @@ def interface_spacing(interface_heights):
     ----------
     interface_heights : array_like
         Mid-height of every interface a = 1 ... n, shape [n] [FE length] (the run's layer
-        heights at :func:`stickslip.fem.output.interface_layers`).
+        heights at :func:`stickslip.mesh.interface_layer`).
 
     Returns
     -------
@@ -293,7 +293,7 @@ def _replay(input):
 @register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
-    from ..fem.output import interface_layers, read_increments, read_run_attrs
+    from ..fem.output import read_increments, read_run_attrs
 
     replay = _replay(input)
     run_attrs = read_run_attrs(input)
@@ -303,7 +303,7 @@ def run(params, input, output):
     N = int(run_attrs["N"])
     with h5io.open_file(input) as file:
         heights = load_mesh(file["mesh"]).layer_mid_height
-    spacing = interface_spacing(heights[interface_layers(run_attrs["n_interfaces"])])
+    spacing = interface_spacing([heights[interface_layer(a)] for a in range(1, int(run_attrs["n_interfaces"]) + 1)])
     classified = extraction.classify_increments(read_increments(input), N, source=str(input))
     failures, fronts = front_tables(classified, replay.failures, N=N, h=float(run_attrs["h"]),
                                     c_s=float(run_attrs["c_s"]), spacing=spacing, params=params)

@@ -15,7 +15,7 @@ this format writes it through here. One HDF5 file per run (written with
     "max_increments").
 ``/mesh``
     The layered mesh (:func:`stickslip.mesh.save_mesh`); with it the run's own interface
-    <-> layer map (:func:`interface_layers`).
+    <-> layer map (``interface_elements``, ``elem_layer``; :func:`stickslip.mesh.interface_layer`).
 ``/event``
     Scaled linear response: ``delta_u`` [ndof], ``delta_eps`` [ni, 4, 3],
     ``delta_target`` [nlayer], ``delta_lever`` [1].
@@ -39,30 +39,12 @@ from ..params import parse_params
 from .parameters import FemParams
 
 __all__ = ["FORMAT", "create_file", "append_increment", "rewrite", "read_increments", "read_run_attrs", "read_params",
-           "RunFile", "interface_layers", "describe"]
+           "RunFile", "describe"]
 
 #: The format name of these files (:mod:`stickslip.formats`).
 FORMAT = "fem-run"
 
 _STATE = ("u", "target", "lever_target", "t")
-
-
-def interface_layers(n_interfaces):
-    """The interface <-> layer map of a run: interface ``a`` is layer ``2a - 1``.
-
-    Layers are numbered from the bottom: plate ``i`` is layer ``2i``, interface ``a``
-    (1 = lowest) the block layer ``2a - 1`` between plates ``a - 1`` and ``a``.
-
-    Parameters
-    ----------
-    n_interfaces : int
-
-    Returns
-    -------
-    numpy.ndarray
-        int64 [n_interfaces]: the layer of interface ``a`` at index ``a - 1``.
-    """
-    return 2 * np.arange(1, int(n_interfaces) + 1, dtype=np.int64) - 1
 
 
 def create_file(file, header, mesh, linear_response, columns):

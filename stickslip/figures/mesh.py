@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.collections import PolyCollection
 
 from ..h5io import FileFormatError, open_file
-from ..mesh import read_mesh, read_mesh_params
+from ..mesh import interface_layer, read_mesh, read_mesh_params
 from ..params import param
 from ..registry import register
 from .style import interface_color, plt, save_figure
@@ -37,9 +37,10 @@ def layer_colors(mesh):
     list
         nlayer matplotlib colours.
     """
+    interfaces = {interface_layer(a) for a in range(1, mesh.n_interfaces + 1)}
     colors = []
     for layer in range(mesh.nlayer):
-        if layer % 2 == 1:
+        if layer in interfaces:
             colors.append("0.15")
         elif layer == 0:
             colors.append("0.7")

@@ -7,7 +7,8 @@ import numpy as np
 
 from .style import N_MARKERS, interface_color, n_color
 
-__all__ = ["density", "plot_density", "range_edges", "linear_edges", "log_edges", "n_style", "individual_style", "a_style", "label_panels"]
+__all__ = ["density", "plot_density", "range_edges", "linear_edges", "log_edges", "n_style",
+           "individual_style", "a_style", "label_panels"]
 
 
 def range_edges(values, bins):

@@ -21,7 +21,25 @@ from .quad4 import stack_rows
 from .rows import (bottom_plate_rows, interface_rows, middle_plate_rows, plate_target_height,
                    top_plate_rows)
 
-__all__ = ["MeshParams", "LayeredMesh", "build_stack_mesh"]
+__all__ = ["MeshParams", "LayeredMesh", "build_stack_mesh", "interface_layer"]
+
+
+def interface_layer(a):
+    """The layer of interface ``a``: ``2a - 1`` (the one place this convention is written).
+
+    Layers are numbered from the bottom: plate ``i`` is layer ``2i``, interface ``a``
+    (1 = lowest) the block layer between plates ``a - 1`` and ``a``.
+
+    Parameters
+    ----------
+    a : int
+        Interface, 1 ... n.
+
+    Returns
+    -------
+    int
+    """
+    return 2 * int(a) - 1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -219,7 +237,7 @@ def build_stack_mesh(params):
     top_nodes = np.flatnonzero(grid[:, 1] == tops[-1])
     iip = np.unique(np.concatenate([dofs[bottom_nodes].ravel(), dofs[top_nodes, 1]]))
 
-    interface_elements = np.stack([np.flatnonzero(elem_layer == 2 * a - 1) for a in range(1, params.plates)])
+    interface_elements = np.stack([np.flatnonzero(elem_layer == interface_layer(a)) for a in range(1, params.plates)])
     return LayeredMesh(coor=grid * params.h, conn=conn, dofs=dofs, iip=iip, elem_layer=elem_layer,
                        layer_y=layer_y, interface_elements=interface_elements.reshape(params.plates - 1, N),
                        N=N, plates=params.plates, h=params.h)

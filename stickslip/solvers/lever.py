@@ -2,7 +2,9 @@
 
 Rigid slabs on a fixed base, springs to a lever driven at constant speed, interfaces with
 logarithmic aging, threshold disorder, optional creep and triggered simultaneous slips
-(model and equations: docs/experiment-model.md; code: :mod:`stickslip.experiment.virtual`).
+(model and equations: docs/experiment-model.md; code: :mod:`stickslip.experiment.virtual`,
+assembled from the parameters in :mod:`stickslip.experiment.virtual.model`; this module is the
+plugin's adapter: parameters in, time-series file out).
 The output is the experimental time-series file (:mod:`stickslip.experiment.timeseries`)
 with the parameters (JSON) and seed as attributes and two ground-truth tables:
 
@@ -21,14 +23,13 @@ creep_total except for a slip still running at the end).
 import dataclasses
 
 import numpy as np
-import pandas as pd
 
 from .. import registry
 from ..experiment.timeseries import PROTOCOLS, write_timeseries
-from ..experiment.virtual import Apparatus, FrictionLaw, integrate, record, relative_positions
+from ..experiment.virtual.model import apparatus, per_interface, simulate
 from ..params import ParameterError, param, params_to_dict
 
-__all__ = ["LeverParams", "run", "simulate", "apparatus", "friction_law", "per_interface", "check_protocol"]
+__all__ = ["LeverParams", "run", "check_protocol", "VERSION"]
 
 VERSION = "1"
 
@@ -107,79 +108,6 @@ def check_protocol(params):
                                  f"protocol, got {params.a}")
         if params.n != 1:
             raise ParameterError(f"parameter 'n': must be 1 for the individual protocol, got {params.n}")
-
-
-def per_interface(params, name):
-    """A per-interface parameter as float64 [n_slabs] (a single value is repeated)."""
-    values = np.asarray(getattr(params, name), dtype=float)
-    return np.broadcast_to(values, (params.n_slabs,)).copy()
-
-
-def apparatus(params):
-    """The :class:`~stickslip.experiment.virtual.Apparatus` of the parameters."""
-    return Apparatus.from_protocol(params.protocol, n=params.n, a=params.a, n_slabs=params.n_slabs,
-                                   k_spring=params.k_spring, normal_force=params.normal_force, h=params.h,
-                                   H=params.H, V=params.V, gamma_start=params.gamma_start)
-
-
-def friction_law(params):
-    """The :class:`~stickslip.experiment.virtual.FrictionLaw` of the parameters.
-
-    The creep velocities are scaled by ``(n_driven - 1) / (n_slabs - 1)``: creep, read as
-    activated by the mechanical noise of the other driven interfaces (paper, "Creep effective
-    temperature"), vanishes for a single driven slab and reaches ``creep_velocity`` for a full stack.
-    """
-    n_driven = params.n if params.protocol == "stack" else 1
-    scale = (n_driven - 1) / max(params.n_slabs - 1, 1)
-    return FrictionLaw(mu_d=per_interface(params, "mu_d"), B=per_interface(params, "B"), T0=params.T0,
-                       offset=params.strength_offset, threshold_noise=params.threshold_noise,
-                       creep_velocity=scale * per_interface(params, "creep_velocity"),
-                       creep_onset=params.creep_onset, trigger_margin=params.trigger_margin)
-
-
-def _interfaces_table(lever, law, history):
-    slippable = np.zeros(lever.n_slabs, bool)
-    slippable[np.asarray(lever.slippable) - 1] = True
-    index = np.arange(1, lever.n_slabs + 1)
-    slips = history.slips.groupby("a")["dR"].agg(["size", "sum"]).reindex(index, fill_value=0)
-    creep = history.creep.assign(total=history.creep["velocity"] * (history.creep["t_off"] - history.creep["t_on"]))
-    creep_total = creep.groupby("a")["total"].sum().reindex(index, fill_value=0.0)
-    ends = relative_positions(history, np.array([0.0, history.duration]))
-    return pd.DataFrame({"a": index, "slippable": slippable, "mu_d": law.mu_d, "B": law.B,
-                         "creep_velocity": law.creep_velocity, "n_slips": slips["size"].to_numpy(np.int64),
-                         "slip_total": slips["sum"].to_numpy(float), "creep_total": creep_total.to_numpy(float),
-                         "R_total": ends[1] - ends[0]})
-
-
-def simulate(params):
-    """Run the virtual experiment.
-
-    Parameters
-    ----------
-    params : LeverParams
-
-    Returns
-    -------
-    record : ExperimentRecord
-        The sensor signals.
-    truth : pandas.DataFrame
-        One row per interface per slip.
-    interfaces : pandas.DataFrame
-        One row per interface.
-
-    Notes
-    -----
-    Two independent random streams derive from ``seed``: the threshold disorder and the
-    sensor noise, so changing a noise level leaves the slips unchanged.
-    """
-    disorder_seed, sensor_seed = np.random.SeedSequence(params.seed).spawn(2)
-    lever, law = apparatus(params), friction_law(params)
-    history = integrate(lever, law, params.duration, params.slip_duration,
-                        np.random.Generator(np.random.PCG64(disorder_seed)))
-    signals = record(lever, lambda times: relative_positions(history, times), history.duration, n=params.n,
-                     protocol=params.protocol, a=params.a, force_rate=params.force_rate, frame_rate=params.frame_rate,
-                     force_noise=params.force_noise, position_noise=params.position_noise, rng=np.random.Generator(np.random.PCG64(sensor_seed)))
-    return signals, history.slips, _interfaces_table(lever, law, history)
 
 
 @registry.register("solver", "lever", VERSION, LeverParams, produces="timeseries",

@@ -24,11 +24,12 @@ from scipy.interpolate import CubicHermiteSpline
 from .. import registry
 from ..experiment.timeseries import write_timeseries
 from ..experiment.virtual import Apparatus, record
+from ..experiment.virtual.model import per_interface
 from ..experiment.virtual.rate_state import RateStateLaw
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS, SlabDynamics
 from ..experiment.virtual.slip_intervals import slip_intervals
 from ..params import ParameterError, param, params_to_dict
-from .lever import LeverParams, check_protocol, per_interface
+from .lever import LeverParams, check_protocol
 
 __all__ = ["RateStateLeverParams", "run", "simulate", "law_of"]
 

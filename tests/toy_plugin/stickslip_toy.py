@@ -30,7 +30,8 @@ from stickslip.formats.event_table import read_slip_events, slip_events_table
 from stickslip.params import param
 from stickslip.registry import register
 
-formats.register_format(formats.Format("toy-block", 1, __name__, "a spring-block history: t [s], x [mm], F [N]",
+formats.register_format(formats.Format("toy-block", 1, __name__,
+                                       "a spring-block history: t [s], x [mm], F [N]",
                                        source="numerical", describe=f"{__name__}:describe"))
 
 
