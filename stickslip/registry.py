@@ -57,6 +57,7 @@ __all__ = [
     "available",
     "run_id",
     "derived_run_id",
+    "config_key",
 ]
 
 KINDS = ("solver", "analysis", "figure")
@@ -73,6 +74,7 @@ _RUN_SIGNATURES = {
 }
 
 _NAME = re.compile(r"^[a-z0-9][A-Za-z0-9_-]*$")
+_LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*$")
 
 _plugins = {kind: {} for kind in KINDS}
 _loaded = False
@@ -309,3 +311,30 @@ def derived_run_id(plugin, params, input_run_ids):
         16 hexadecimal characters.
     """
     return short_hash({"run": run_id(plugin, params), "inputs": sorted(input_run_ids)})
+
+
+def config_key(key):
+    """Split a config key of an analysis or figure into the plugin name and its label.
+
+    ``name@label`` names one more parameterisation of the plugin ``name``: its outputs
+    go under ``name@label`` (``events/front-dynamics@all/...``, ``figures/figS-tau@all.pdf``),
+    so one study can hold several. A plain ``name`` has no label.
+
+    Parameters
+    ----------
+    key : str
+
+    Returns
+    -------
+    tuple[str, str]
+        ``(name, label)``; ``label`` is ``""`` for a plain name.
+
+    Raises
+    ------
+    PluginError
+        If the label is empty or not letters, digits, ``-`` and ``_``.
+    """
+    name, at, label = key.partition("@")
+    if at and not _LABEL.match(label):
+        raise PluginError(f"{key!r}: the label after '@' must match {_LABEL.pattern}")
+    return name, label

@@ -188,9 +188,10 @@ def _grid_schema(params_cls):
     return {"type": "object", "properties": properties, "additionalProperties": False}
 
 
-def _plugin(kind, name, where):
+def _plugin(kind, key, where):
+    """The plugin of a config key (``name`` or ``name@label``, see :func:`stickslip.registry.config_key`)."""
     try:
-        return registry.get(kind, name)
+        return registry.get(kind, registry.config_key(key)[0])
     except registry.PluginError as error:
         raise ParameterError(f"config {where}: {error}") from None
 
@@ -365,10 +366,16 @@ class Study:
         """The mesh file of ``mesh_id`` as an :class:`~stickslip.lineage.Artifact`."""
         return Artifact(self.path("mesh", mesh_id=mesh_id), mesh_id, "mesh", "mesh")
 
-    def _category(self, category):
-        """Artifacts of one figure input category, sorted by path."""
+    def _category(self, category, label):
+        """Artifacts of one figure input category, sorted by path.
+
+        ``analysis:<name>`` takes the analysis labelled like the figure (``name@label``) if
+        the study has it, else the plain one.
+        """
         kind, _, name = category.partition(":")
         if kind == "analysis":
+            if label and f"{name}@{label}" in self.analyses:
+                name = f"{name}@{label}"
             found = [job.artifact() for job in self.analysis_jobs if job.analysis == name]
         elif name == "mesh":
             found = [self.mesh_artifact(m) for m in self.meshes]
@@ -383,7 +390,7 @@ class Study:
             params = params_to_dict(_parse(plugin, values, _where("figures", name)))
             inputs = {}
             for category in plugin.inputs:
-                inputs[category] = self._category(category)
+                inputs[category] = self._category(category, registry.config_key(name)[1])
                 if not inputs[category]:
                     raise ParameterError(f"config figures.{name}: it reads {category} outputs, which the "
                                          "study does not produce (add the solver or analysis to the config)")
@@ -462,12 +469,12 @@ class Study:
             from .mesh import write_mesh
 
             return code_hash(write_mesh.__module__)
-        return code_hash(registry.get(kind, name).module)
+        return code_hash(registry.get(kind, registry.config_key(name)[0]).module)
 
     @staticmethod
     def caption(figure):
         """Return the caption of a figure: its plugin's summary, name and version."""
-        plugin = registry.get("figure", figure)
+        plugin = registry.get("figure", registry.config_key(figure)[0])
         return f"{plugin.summary} (figure plugin ``{plugin.name}`` version {plugin.version}, {plugin.module})"
 
     @staticmethod

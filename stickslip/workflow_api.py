@@ -118,7 +118,7 @@ def _plugin_recording(record, outputs, plugin, params, run_id, **extra):
 
 
 def _load(kind, name, params_json):
-    plugin = registry.get(kind, name)
+    plugin = registry.get(kind, registry.config_key(name)[0])
     params = parse_params(plugin.params, json.loads(params_json), owner=f"{kind} '{name}'")
     return plugin, params
 

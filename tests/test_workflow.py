@@ -292,3 +292,40 @@ def test_two_studies_in_one_clone_keep_their_results(toy_workflow, toy_distribut
         assert connection.execute("SELECT COUNT(*) FROM simulations").fetchone()[0] == 1
     again = snakemake(directory, "-n", "--cores", "2", "--configfile", "toy.yaml", distribution=toy_distribution)
     assert "Nothing to be done" in again.stdout + again.stderr
+
+
+def test_labelled_config_keys_are_more_parameterisations(toy_plugins):
+    config = copy.deepcopy(TOY_CONFIG)
+    config["analyses"]["toy-slips@coarse"] = {"threshold": 0.5}
+    config["figures"]["toy-force@coarse"] = {}
+    study = Study(config)
+    fine = {job.path for job in study.analysis_jobs if job.analysis == "toy-slips"}
+    coarse = {job.path for job in study.analysis_jobs if job.analysis == "toy-slips@coarse"}
+    assert len(fine) == len(coarse) == 3 and all("/events/toy-slips@coarse/" in path for path in coarse)
+    assert {job.run_id for job in study.analysis_jobs if job.analysis == "toy-slips@coarse"}.isdisjoint(
+        {job.run_id for job in study.analysis_jobs if job.analysis == "toy-slips"})
+    # the labelled figure reads the analysis labelled alike, the plain one the plain analysis
+    assert {str(item) for item in study.figures["toy-force@coarse"].inputs["analysis:toy-slips"]} == coarse
+    assert {str(item) for item in study.figures["toy-force"].inputs["analysis:toy-slips"]} == fine
+    assert study.figures["toy-force@coarse"].path == "results/default/figures/toy-force@coarse.pdf"
+    with pytest.raises(ParameterError, match="the label after '@' must match"):
+        Study({**copy.deepcopy(TOY_CONFIG), "analyses": {"toy-slips@": {}}})
+
+
+@pytest.mark.slow
+def test_labelled_keys_make_their_own_jobs(tmp_path, toy_distribution):
+    copy_workflow(tmp_path)
+    labelled = TOY_YAML.replace("  toy-slips:\n", "  toy-slips:\n  toy-slips@coarse: {threshold: 0.5}\n")
+    (tmp_path / "labels.yaml").write_text(labelled + "  toy-force@coarse: {}\n")
+    result = snakemake(tmp_path, "-n", "--configfile", "labels.yaml", distribution=toy_distribution)
+    assert planned_jobs(result.stdout + result.stderr) == {"all": 1, "database": 1, "events": 6,
+                                                           "figure_toy_force": 1, "figure_toy_force_coarse": 1,
+                                                           "simulate": 3}
+    snakemake(tmp_path, "--cores", "2", "--configfile", "labels.yaml", distribution=toy_distribution)
+    results = tmp_path / "results" / "labels"
+    assert (results / "figures" / "toy-force@coarse.png").stat().st_size > 1000
+    with sqlite3.connect(results / "stickslip.sqlite") as connection:
+        analyses = connection.execute("SELECT plugin, COUNT(*) FROM runs WHERE kind = 'analysis' "
+                                      "GROUP BY plugin").fetchall()
+        params = {row[0] for row in connection.execute("SELECT params FROM runs WHERE kind = 'analysis'")}
+    assert analyses == [("toy-slips", 6)] and len(params) == 2

@@ -42,7 +42,7 @@ CONDA_ENV = "../envs/stickslip.yaml"
 
 wildcard_constraints:
     solver=r"[a-z0-9][A-Za-z0-9_-]*",
-    analysis=r"[a-z0-9][A-Za-z0-9_-]*",
+    analysis=r"[a-z0-9][A-Za-z0-9_-]*(@[A-Za-z0-9][A-Za-z0-9_-]*)?",
     run_id=r"[0-9a-f]{16}",
     mesh_id=r"[0-9a-f]{16}",
 

@@ -1,4 +1,4 @@
-# One rule per figure (figure_<name>, "-" as "_"), so that `--forcerun figure_<name>` redraws
+# One rule per figure (figure_<name>, "-" and "@" as "_"), so that `--forcerun figure_<name>` redraws
 # that figure alone. The caption comes from the figure plugin's summary (report/figure.rst). The job
 # receives its inputs with their lineage: each analysis output paired with its simulation.
 
@@ -6,7 +6,7 @@ for _figure, _job in STUDY.figures.items():
 
     rule:
         name:
-            f"figure_{_figure.replace('-', '_')}"
+            f"figure_{_figure.replace('-', '_').replace('@', '_')}"
         input:
             _job.files(),
         output:
