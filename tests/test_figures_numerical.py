@@ -109,7 +109,7 @@ def test_paper_figures_leave_out_runs_away_from_the_paper_phi(study, tmp_path):
     attrs = {"N": N, "plates": 3, "k_drive": K_DRIVE["stiff"] / 30, "seed": 0, "c_s": C_S, "h": H_BLOCK}
     tables = plugin.event_tables(history(N, random_events(2, "stiff", np.random.default_rng(1)), load_gamma=0.7), N)
     sweep = tmp_path / "sweep.h5"
-    plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), sweep)
+    plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), sweep, input=__file__)
     inputs = {"analysis:numerical-events": [*study["analysis:numerical-events"], sweep]}
     paper = read_inputs(inputs, "analysis:numerical-events", ("slips",), "fig2")
     assert len(paper) == 6 and str(sweep) not in {item.path for item in paper}

@@ -23,8 +23,8 @@ from scipy.interpolate import CubicHermiteSpline
 
 from .. import registry
 from ..experiment.timeseries import write_timeseries
-from ..experiment.virtual import Apparatus, record
-from ..experiment.virtual.model import per_interface
+from ..experiment.virtual import record
+from ..experiment.virtual.model import apparatus as apparatus_of, per_interface
 from ..experiment.virtual.rate_state import RateStateLaw
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS, SlabDynamics
 from ..experiment.virtual.slip_intervals import slip_intervals
@@ -117,9 +117,7 @@ def simulate(params):
     steps : int
         Integrator steps.
     """
-    apparatus = Apparatus.from_protocol(params.protocol, n=params.n, a=params.a, n_slabs=params.n_slabs,
-                                        k_spring=params.k_spring, normal_force=params.normal_force, h=params.h,
-                                        H=params.H, V=params.V, gamma_start=params.gamma_start)
+    apparatus = apparatus_of(params)
     law = law_of(params)
     dynamics = SlabDynamics(apparatus, law, params.slab_mass, params.load_mass)
     R0, y0 = dynamics.initial_state(params.V_start, params.theta_start, params.gamma_start)
