@@ -12,6 +12,7 @@ import sqlite3
 import pytest
 
 from conftest import copy_workflow
+from stickslip.fem.output import read_run_attrs
 from stickslip.provenance.record import read_record
 from test_workflow import snakemake
 
@@ -40,6 +41,8 @@ def test_a_second_solver_needs_no_edit_of_the_package(tmp_path, toy_distribution
     snakemake(directory, "--cores", "2", "--configfile", "twin.yaml", distribution=toy_distribution)
     results = directory / "results" / "twin"
     (sim,) = (results / "sim" / "fem-twin").glob("*.h5")
+    attrs = read_run_attrs(sim)
+    assert (attrs["format"], attrs["solver"], attrs["solver_version"]) == ("fem-run", "fem-twin", "1")
     for name in ("fig2", "figS-dgamma", "figS-sequences", "figS-event-maps", "figS-tau", "figS-mesh"):
         assert (results / "figures" / f"{name}.pdf").stat().st_size > 1000, name
     record = read_record(results / "events" / "front-dynamics" / "fem-twin" / sim.with_suffix(".provenance.json").name)

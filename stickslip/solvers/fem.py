@@ -15,13 +15,30 @@ from ..fem.run import run_simulation
 from ..h5io import FileFormatError
 from ..mesh import MeshParams, build_stack_mesh, read_mesh
 
-__all__ = ["FemParams", "run", "VERSION"]
+__all__ = ["FemParams", "run", "stack_mesh", "VERSION"]
 
 #: Algorithm version (part of every run id); bump when results change.
 VERSION = "2"  # 2: structured plate kernel (results change at round-off), relaxation, dt_scale
 
 
-def _mesh(params, inputs):
+def stack_mesh(params, inputs):
+    """The mesh of a run: the ``mesh`` input if given (checked against ``N`` and ``plates``), else built.
+
+    Parameters
+    ----------
+    params : FemParams
+    inputs : Mapping[str, os.PathLike] or None
+        The solver's inputs by format; ``"mesh"``, if present, is a mesh file.
+
+    Returns
+    -------
+    stickslip.mesh.LayeredMesh
+
+    Raises
+    ------
+    FileFormatError
+        If the mesh file's ``N`` or ``plates`` differ from the parameters.
+    """
     path = (inputs or {}).get("mesh")
     if path is None:
         return build_stack_mesh(MeshParams(N=params.N, plates=params.plates))
@@ -35,4 +52,4 @@ def _mesh(params, inputs):
 @registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads=1, inputs=None):
     """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
-    run_simulation(params, output, _mesh(params, inputs), threads=threads, producer=("fem", VERSION))
+    run_simulation(params, output, stack_mesh(params, inputs), threads=threads, producer=("fem", VERSION))

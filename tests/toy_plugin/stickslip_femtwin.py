@@ -1,19 +1,23 @@
 """A second solver of the ``fem-run`` format, registered through an entry point only.
 
-``fem-twin`` is a thin wrapper around the package's ``fem`` solver under another name, as a
-third-party backend (another kernel set, a GPU) would be: it declares the formats it consumes
-(``mesh``) and produces (``fem-run``) and offers the event replay of the files it writes.
+``fem-twin`` runs the package's fem model under another name, as a third-party backend
+(another kernel set, a GPU) would: it declares the formats it consumes (``mesh``) and
+produces (``fem-run``), writes the format through its writer with its own name as the
+producer, and offers the event replay of the files it writes.
 The package's analyses, figures and database take its runs with no edit
 (tests/test_second_solver.py).
 """
 
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.replay import EventReplay
+from stickslip.fem.run import run_simulation
 from stickslip.registry import register
-from stickslip.solvers import fem
+from stickslip.solvers.fem import stack_mesh
+
+VERSION = "1"
 
 
-@register("solver", "fem-twin", "1", FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
+@register("solver", "fem-twin", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads, inputs):
     """The fem model under another name (test plugin: a second fem-run solver)."""
-    fem.run(params, output, threads=threads, inputs=inputs)
+    run_simulation(params, output, stack_mesh(params, inputs), threads=threads, producer=("fem-twin", VERSION))
