@@ -18,9 +18,12 @@ Tables (event lists, per-increment observables) are stored as a group with one
 :class:`pandas.DataFrame`.
 """
 
+import errno
 import fcntl
 import json
 import os
+import re
+import shutil
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -29,13 +32,20 @@ import h5py
 import numpy as np
 import pandas as pd
 
+from .write_guard import WriteGuard
+
 __all__ = ["open_file", "write_dataset", "write_table", "read_table", "write_attrs", "atomic_output",
-           "copy_file", "writer_lock", "FileFormatError", "UnreadableFileError"]
+           "copy_file", "writer_lock", "FileFormatError", "UnreadableFileError", "OutputError",
+           "check_output", "check_free_space"]
 
 LIBVER = ("v110", "v110")
 
 #: What HDF5 says about a file whose writer is running or was killed without closing it.
 _OPEN_FOR_WRITE = "file is already open for write"
+
+#: errno values that mean "the output cannot be written", reported as :class:`OutputError`.
+_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOENT,
+                 errno.ENOTDIR, errno.EISDIR)
 
 #: Bytes per block in which :func:`copy_file` copies a dataset (bounded memory).
 _COPY_BLOCK_BYTES = 64 * 2**20
@@ -49,13 +59,30 @@ class UnreadableFileError(FileFormatError):
     """A file exists but HDF5 cannot open it (not HDF5, truncated, or damaged)."""
 
 
+class OutputError(OSError):
+    """An output file cannot be written (full disk, no permission, read-only file system); the message says which.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The output file.
+    code : int
+        The ``errno`` of the failure.
+    """
+
+    def __init__(self, path, code):
+        super().__init__(f"{path}: cannot write it ({os.strerror(code)})")
+        self.errno = code
+
+
 def open_file(path, mode="r"):
     """Open an HDF5 file with the package's reproducible settings.
 
     Parameters
     ----------
     path : str or pathlib.Path
-    mode : {"r", "r+", "w", "a", "x"}
+    mode : {"r", "r+", "w"}
+        Read; read and write an existing file; create (or empty) a file.
 
     Returns
     -------
@@ -67,6 +94,14 @@ def open_file(path, mode="r"):
     :func:`writer_lock`). A file whose writer is running, or was killed, in SWMR
     mode is opened as an SWMR reader: it shows what the writer had flushed.
 
+    A new file (``"w"``) is written through a :class:`~stickslip.write_guard.WriteGuard`,
+    so that a failed write (full disk) raises :class:`OutputError` from
+    :meth:`~h5py.File.flush` or :meth:`~h5py.File.close`, where HDF5 itself would
+    crash; the file is then incomplete. An existing file (``"r+"``) is opened
+    directly: the guard's file driver would not mark the file as open for writing
+    in the way SWMR readers need (HDF5 sets that flag with its file lock only);
+    its writer checks the free space itself (:func:`check_free_space`).
+
     Raises
     ------
     FileFormatError
@@ -75,20 +110,52 @@ def open_file(path, mode="r"):
         If it is not a readable HDF5 file.
     """
     path = Path(path)
-    if mode in ("r", "r+"):
-        if not path.is_file():
-            raise FileFormatError(f"{path}: no such file")
-        reading = {"locking": False} if mode == "r" else {"libver": LIBVER}
+    if mode not in ("r", "r+", "w"):
+        raise ValueError(f"mode must be 'r', 'r+' or 'w', not {mode!r}")
+    if mode in ("r", "r+") and not path.is_file():
+        raise FileFormatError(f"{path}: no such file")
+    if mode == "w":
+        return _GuardedFile(WriteGuard(path))
+    reading = {"locking": False} if mode == "r" else {"libver": LIBVER}
+    try:
+        return h5py.File(path, mode, **reading)
+    except OSError as error:
+        if mode == "r" and _OPEN_FOR_WRITE in str(error):
+            try:
+                return h5py.File(path, "r", swmr=True, **reading)
+            except OSError:
+                pass
+        raise UnreadableFileError(f"{path}: not a readable HDF5 file ({error})") from error
+
+
+class _GuardedFile(h5py.File):
+    """An HDF5 file written through a :class:`~stickslip.write_guard.WriteGuard`: a failed write
+    (full disk) raises :class:`OutputError` from :meth:`flush` and :meth:`close`."""
+
+    def __init__(self, guard):
         try:
-            return h5py.File(path, mode, **reading)
-        except OSError as error:
-            if mode == "r" and _OPEN_FOR_WRITE in str(error):
-                try:
-                    return h5py.File(path, "r", swmr=True, **reading)
-                except OSError:
-                    pass
-            raise UnreadableFileError(f"{path}: not a readable HDF5 file ({error})") from error
-    return h5py.File(path, mode, libver=LIBVER, track_order=False)
+            super().__init__(guard, "w", libver=LIBVER, track_order=False)
+        except BaseException:
+            guard.close()
+            raise
+        self._guard = guard
+
+    def flush(self):
+        """Write what HDF5 holds to the file; raise OutputError if a write failed."""
+        super().flush()
+        self._check()
+
+    def close(self):
+        """Close the file; raise OutputError if a write failed."""
+        super().close()
+        try:
+            self._guard.close()
+        finally:
+            self._check()
+
+    def _check(self):
+        if self._guard.error is not None:
+            raise OutputError(self._guard.name, self._guard.error.errno) from self._guard.error
 
 
 def write_dataset(group, name, data, **kwargs):
@@ -186,7 +253,10 @@ def read_table(group, name, rows=None):
 def atomic_output(path):
     """Write a file under a temporary name and rename it into place on success.
 
-    An interrupted writer leaves the previous file (or none) intact.
+    An interrupted or failing writer leaves the previous file (or none) intact, and
+    no temporary file. The temporary file ``.<name>.<random>.tmp`` is locked
+    (``flock``) while it is written; temporaries of ``path`` that no live process
+    holds (left by a process that was killed) are removed first.
 
     Parameters
     ----------
@@ -197,22 +267,157 @@ def atomic_output(path):
     ------
     pathlib.Path
         Temporary path in the same directory, to write to.
+
+    Raises
+    ------
+    OutputError
+        If the file cannot be written (full disk, no permission, read-only file
+        system, ``path`` a directory); the message names ``path`` and the cause.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    tmp = Path(tmp)
+    with _output_errors(path):
+        _make_directory(path)
+        _remove_stale_temporaries(path)
+        fd, tmp = _locked_temporary(path)
     umask = os.umask(0)
     os.umask(umask)
     try:
-        yield tmp
-        if tmp.exists():  # mkstemp makes it private; the result gets the usual permissions
-            os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        with _output_errors(path):
+            yield tmp
+            if tmp.exists():  # mkstemp makes it private; the result gets the usual permissions
+                os.chmod(tmp, 0o666 & ~umask)
+            os.replace(tmp, path)
     finally:
-        if tmp.exists():
-            tmp.unlink()
+        tmp.unlink(missing_ok=True)
+        os.close(fd)
+
+
+def check_output(path):
+    """Raise now if ``path`` cannot be written, before a long computation would find it out.
+
+    Makes the missing directories and a temporary file beside ``path`` (removed again).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Raises
+    ------
+    OutputError
+        If ``path`` is a directory, or its directory cannot be made or written to.
+    """
+    path = Path(path)
+    with _output_errors(path):
+        _make_directory(path)
+        fd, tmp = _locked_temporary(path)
+        tmp.unlink()
+        os.close(fd)
+
+
+def check_free_space(path, nbytes):
+    """Raise OutputError (ENOSPC) unless the file system of ``path`` has ``nbytes`` free.
+
+    For a writer that appends to an existing file in place, where a write that fails
+    for lack of space would crash HDF5: checked before each append, with a margin,
+    it ends the writer cleanly instead. (Space taken by another process between the
+    check and the write, and quotas, which the check does not see, are not covered.)
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file appended to.
+    nbytes : int
+        Bytes needed [B].
+
+    Raises
+    ------
+    OutputError
+        If less is free (for unprivileged users).
+    """
+    if shutil.disk_usage(Path(path).parent).free < nbytes:
+        raise OutputError(path, errno.ENOSPC)
+
+
+def _make_directory(path):
+    """Make the directory of the output file ``path`` (IsADirectoryError if ``path`` is one)."""
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:  # a file where a directory should be
+        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR)) from None
+
+
+@contextmanager
+def _output_errors(path):
+    """Turn an OSError of writing into :class:`OutputError` naming ``path``."""
+    try:
+        yield
+    except OSError as error:
+        if error.errno not in _WRITE_ERRNOS:
+            raise
+        raise OutputError(path, error.errno) from error
+
+
+def _temporary_name(path):
+    """Pattern of the names :func:`tempfile.mkstemp` gives the temporaries of ``path``."""
+    return re.compile(rf"\.{re.escape(path.name)}\.[a-z0-9_]{{8}}\.tmp")
+
+
+def _locked_temporary(path):
+    """Create a temporary file beside ``path`` and lock it; return (descriptor, path).
+
+    The lock is taken after the file appears, so :func:`_remove_stale_temporaries`
+    of another process may lock and remove it in between; it is then made again.
+    """
+    while True:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        if _same_file(fd, tmp):
+            return fd, Path(tmp)
+        os.close(fd)
+
+
+def _same_file(fd, path):
+    """Whether ``path`` is (still) the file open as ``fd``."""
+    try:
+        return os.path.samestat(os.fstat(fd), os.stat(path))
+    except FileNotFoundError:
+        return False
+
+
+def _remove_stale_temporaries(path):
+    """Remove the temporaries of :func:`atomic_output` for ``path`` that no process holds.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        Final path; its directory is searched for ``.<name>.<random>.tmp``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files removed.
+    """
+    pattern = _temporary_name(path)
+    removed = []
+    for candidate in sorted(path.parent.iterdir()):
+        if not pattern.fullmatch(candidate.name):
+            continue
+        try:
+            fd = os.open(candidate, os.O_RDONLY)
+        except FileNotFoundError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            if _same_file(fd, candidate):
+                candidate.unlink()
+                removed.append(candidate)
+        except BlockingIOError:
+            pass
+        finally:
+            os.close(fd)
+    return removed
 
 
 def copy_file(source, target, rows):

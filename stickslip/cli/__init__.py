@@ -12,7 +12,7 @@ import argparse
 import importlib
 import sys
 
-from ..h5io import FileFormatError
+from ..h5io import FileFormatError, OutputError
 from ..params import ParameterError
 from ..registry import PluginError
 from ..termination import exit_status, interruption, sigterm_as_interrupt
@@ -22,7 +22,7 @@ __all__ = ["main", "COMMANDS"]
 #: Sub-command modules, in the order of ``stickslip --help``.
 COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db")
 
-USER_ERRORS = (ParameterError, PluginError, FileFormatError)
+USER_ERRORS = (ParameterError, PluginError, FileFormatError, OutputError)
 
 
 def build_parser():

@@ -3,6 +3,7 @@
 from pathlib import Path
 
 from .. import registry
+from ..h5io import check_output
 from ..numba_options import set_num_threads
 from ..params import parse_assignments, parse_params
 
@@ -26,6 +27,6 @@ def run(args):
     plugin = registry.get("solver", args.solver)
     params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
     threads = set_num_threads(args.threads)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
+    check_output(args.output)
     plugin.run(params, args.output, threads=threads, inputs={})
     return 0

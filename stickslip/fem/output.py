@@ -175,6 +175,12 @@ class RunFile:
         s = self.file["state"]
         return s["u"][increment], s["target"][increment], float(s["lever_target"][increment]), float(s["t"][increment])
 
+    def increment_bytes(self):
+        """Bytes that appending one increment may allocate at most: one new chunk of every growing dataset [B]."""
+        datasets = [self.file["state"][name] for name in _STATE]
+        datasets += [self.file["increments"][name] for name in json.loads(self.file["increments"].attrs["columns"])]
+        return sum(int(np.prod(d.chunks)) * d.dtype.itemsize for d in datasets)
+
     def linear_response(self):
         """(delta_u, delta_eps, delta_target, delta_lever) as stored."""
         e = self.file["event"]

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
-from ..h5io import FileFormatError, UnreadableFileError, atomic_output, open_file, writer_lock
+from ..h5io import FileFormatError, UnreadableFileError, atomic_output, check_free_space, open_file, writer_lock
 from ..params import params_to_dict
 from .minimise import within_margin
 from .observables import Observer, observable_columns
@@ -32,6 +32,10 @@ from .stiffness import driving_regime, stiffness_ratio
 from .system import System
 
 __all__ = ["run_simulation"]
+
+#: Free space kept beyond one increment's chunks [B]: HDF5 crashes if a write for lack of space
+#: fails in the file appended to, so the loop stops cleanly (OutputError) before the disk is full.
+FREE_SPACE_MARGIN = 4 * 2**20
 
 
 def _row(observer, increment, kick, yield_element, previous_index):
@@ -130,7 +134,8 @@ def run_simulation(params, output, mesh, threads=1, *, producer):
     the run ends (an exception, SIGINT, SIGTERM, SIGKILL), the next call rewrites
     the file from its committed increments (:func:`.output.rewrite`) and resumes;
     a file that HDF5 cannot open is moved aside with a message and the run starts
-    over. A finished run is rewritten once more, so that the file has the same bytes
+    over. A disk that fills up ends the run before an increment is written
+    (:data:`FREE_SPACE_MARGIN`); it resumes when rerun with space. A finished run is rewritten once more, so that the file has the same bytes
     however often the run was interrupted.
 
     Parameters
@@ -155,6 +160,8 @@ def run_simulation(params, output, mesh, threads=1, *, producer):
     FileFormatError
         If ``output`` exists with other parameters, is not a simulation file, or
         another process is writing it.
+    OutputError
+        If the disk is (nearly) full, or ``output`` cannot be written.
     """
     output = Path(output)
     with writer_lock(output):
@@ -185,6 +192,7 @@ def _increments(params, output, threads):
         new = 0
         reason = ""
         report = _Progress(file, params, increment)
+        needed = 2 * run.increment_bytes() + FREE_SPACE_MARGIN
         while not reason:
             if params.max_increments and increment >= params.max_increments:
                 reason = "max_increments"
@@ -202,6 +210,7 @@ def _increments(params, output, threads):
                 if not system.extend and not within_margin(system.model, system.state.idx, params.margin):
                     reason = "margin"
                     break
+            check_free_space(output, needed)
             append_increment(file, system.snapshot(), _row(observer, increment, kick, yield_element, previous_index))
             previous_index = observer.well_index()
             new += 1
