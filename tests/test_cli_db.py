@@ -36,6 +36,34 @@ def test_db_commands(toy_results, capsys):
     assert status == 0 and "5 records" in text
     capsys.readouterr()
     status, _ = _run("db", "sql", "DROP TABLE runs")
-    assert status == 2 and "readonly" in capsys.readouterr().err
+    assert status == 2 and "only reads" in capsys.readouterr().err
     status, _ = _run("db", "runs", "--db", "nowhere.sqlite")
     assert status == 2 and "nowhere.sqlite: no such database" in capsys.readouterr().err
+
+
+def test_db_sql_only_reads(toy_results, capsys, tmp_path):
+    assert _run("db", "rebuild")[0] == 0
+    database = tmp_path / "results" / "default" / "stickslip.sqlite"
+    before = database.read_bytes()
+    capsys.readouterr()
+    refused = {
+        f"VACUUM INTO '{tmp_path / 'copy.sqlite'}'": "only reads",
+        f"ATTACH DATABASE '{tmp_path / 'new.sqlite'}' AS new": "only reads",
+        "PRAGMA writable_schema=ON": "only reads",
+        "PRAGMA query_only=OFF": "only reads",
+        "CREATE TEMP TABLE scratch(x)": "only reads",
+        "DELETE FROM runs": "only reads",
+        "": "empty query",
+        "   ": "empty query",
+    }
+    for query, cause in refused.items():
+        status, text = _run("db", "sql", query)
+        err = capsys.readouterr().err
+        assert status == 2 and text == "" and len(err.splitlines()) == 1 and cause in err, (query, err)
+    assert not (tmp_path / "copy.sqlite").exists() and not (tmp_path / "new.sqlite").exists()
+    assert database.read_bytes() == before
+    status, text = _run("db", "sql", "PRAGMA table_info(runs)", "--format", "csv")
+    assert status == 0 and "run_id" in pd.read_csv(io.StringIO(text))["name"].tolist()
+    status, text = _run("db", "sql", "WITH RECURSIVE r(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM r WHERE i < 3) "
+                                     "SELECT SUM(i) AS s FROM r", "--format", "csv")
+    assert status == 0 and text.splitlines() == ["s", "6"]

@@ -5,6 +5,7 @@ never change it, and returns a :class:`pandas.DataFrame`. Filters left at
 ``None`` are not applied.
 """
 
+import sqlite3
 from pathlib import Path
 
 import pandas as pd
@@ -14,7 +15,7 @@ from sqlalchemy import select, text
 from ..h5io import FileFormatError
 from .database import Figure, Run, Simulation, engine_for
 
-__all__ = ["DEFAULT_DATABASE", "QueryError", "runs", "events", "figures", "sql"]
+__all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "runs", "events", "figures", "sql"]
 
 #: Where the workflow writes the database of the default study (relative to the workflow directory);
 #: a study named S has ``results/S/stickslip.sqlite``.
@@ -36,13 +37,34 @@ def _engine(database):
 INTEGER_COLUMNS = ("n", "a", "plates", "blocks", "seed", "threads", "event", "interface", "increment")
 
 
-def _frame(database, statement):
+#: PRAGMAs that ``db sql`` allows: they only describe the schema, whatever their argument.
+READ_ONLY_PRAGMAS = ("table_info", "table_xinfo", "table_list", "index_list", "index_info", "index_xinfo",
+                     "foreign_key_list", "database_list")
+
+#: SQLite authorizer actions of a query that only reads.
+_READING = (sqlite3.SQLITE_SELECT, sqlite3.SQLITE_READ, sqlite3.SQLITE_FUNCTION, sqlite3.SQLITE_RECURSIVE)
+
+
+def _only_reading(action, name, argument, _database, _trigger):
+    """SQLite authorizer: allow reading, deny everything else (ATTACH, VACUUM INTO, temporary tables, PRAGMA writes)."""
+    if action in _READING or (action == sqlite3.SQLITE_PRAGMA and name in READ_ONLY_PRAGMAS):
+        return sqlite3.SQLITE_OK
+    return sqlite3.SQLITE_DENY
+
+
+def _frame(database, statement, only_reading=False):
     engine = _engine(database)
     try:
         with engine.connect() as connection:
+            if only_reading:
+                connection.connection.driver_connection.set_authorizer(_only_reading)
             frame = pd.read_sql(statement, connection)
+    except sqlalchemy.exc.ResourceClosedError:
+        raise QueryError(f"{database}: the statement returns no rows; `db sql` runs queries (SELECT)") from None
     except (pd.errors.DatabaseError, sqlalchemy.exc.DBAPIError) as error:
         cause = getattr(error.__cause__, "orig", None) or error.__cause__ or error
+        if "authoriz" in str(cause):  # "not authorized", "authorization denied"
+            cause = f"refused ({cause}): `db sql` only reads (SELECT, WITH, PRAGMA {', '.join(READ_ONLY_PRAGMAS)})"
         raise QueryError(f"{database}: query failed: {cause}") from None
     finally:
         engine.dispose()
@@ -147,12 +169,17 @@ def figures(database=DEFAULT_DATABASE):
 
 
 def sql(query, database=DEFAULT_DATABASE):
-    """Run any SQL on a read-only connection and return the result.
+    """Run one SQL query on a read-only connection and return the result.
+
+    Besides the read-only connection (``mode=ro``), an SQLite authorizer allows only
+    reading: ``SELECT`` and ``WITH`` queries and the schema PRAGMAs of
+    :data:`READ_ONLY_PRAGMAS`. ``ATTACH`` and ``VACUUM INTO`` (which would write other
+    files), temporary tables and every other PRAGMA are refused.
 
     Parameters
     ----------
     query : str
-        One SQL statement (``SELECT ...``); writes fail (read-only connection).
+        One SQL query (``SELECT ...``).
     database : str or pathlib.Path
 
     Returns
@@ -162,10 +189,12 @@ def sql(query, database=DEFAULT_DATABASE):
     Raises
     ------
     QueryError
-        If the SQL is wrong or tries to write.
+        If the SQL is empty or wrong, returns no rows, or does anything but read.
 
     Notes
     -----
     Cost: whatever the query costs; the indexes are listed in docs/database.md.
     """
-    return _frame(database, text(query))
+    if not query.strip():
+        raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
+    return _frame(database, text(query), only_reading=True)
