@@ -97,8 +97,6 @@ def test_an_output_that_is_a_directory_or_under_no_directory_is_refused_at_once(
 WRITER = textwrap.dedent("""
     import os, signal, sys, time
     from stickslip import h5io
-from stickslip.fem.output import RunFile
-from stickslip.fem.run import FREE_SPACE_MARGIN
     with h5io.atomic_output(sys.argv[1]) as tmp, h5io.open_file(tmp, "w") as f:
         h5io.write_dataset(f, "x", list(range(100)))
         f.flush()
