@@ -25,6 +25,7 @@ import os
 import re
 import shutil
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -34,14 +35,20 @@ import pandas as pd
 
 from .write_guard import WriteGuard
 
-__all__ = ["open_file", "write_dataset", "write_table", "read_table", "write_attrs", "atomic_output",
-           "copy_file", "writer_lock", "FileFormatError", "UnreadableFileError", "OutputError",
+__all__ = ["open_file", "write_dataset", "read_array", "write_table", "read_table", "write_attrs", "atomic_output",
+           "copy_file", "writer_lock", "FileFormatError", "UnreadableFileError", "CorruptFileError", "OutputError",
            "check_output", "check_free_space"]
 
 LIBVER = ("v110", "v110")
 
 #: What HDF5 says about a file whose writer is running or was killed without closing it.
 _OPEN_FOR_WRITE = "file is already open for write"
+
+#: dtype kinds that take the fletcher32 checksum: booleans, integers, floats, complex, fixed-length bytes.
+_CHECKSUMMED_KINDS = "biufcS"
+
+#: Reads of a dataset of a file being written (SWMR) before a failed checksum counts as damage.
+_SWMR_READ_ATTEMPTS = 4
 
 #: errno values that mean "the output cannot be written", reported as :class:`OutputError`.
 _WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOENT,
@@ -57,6 +64,10 @@ class FileFormatError(ValueError):
 
 class UnreadableFileError(FileFormatError):
     """A file exists but HDF5 cannot open it (not HDF5, truncated, or damaged)."""
+
+
+class CorruptFileError(FileFormatError):
+    """Stored data fails its checksum or cannot be decompressed: the file is damaged."""
 
 
 class OutputError(OSError):
@@ -159,21 +170,65 @@ class _GuardedFile(h5py.File):
 
 
 def write_dataset(group, name, data, **kwargs):
-    """Create a dataset without modification times (so equal data gives equal bytes).
+    """Create a dataset without modification times (so equal data gives equal bytes), with checksums.
+
+    Arrays of numbers, booleans and fixed-length bytes get HDF5's ``fletcher32``
+    checksum on every chunk (they are chunked for it): a damaged chunk then fails to
+    read (:func:`read_array`) instead of giving wrong numbers. Scalars and strings
+    cannot carry the filter.
 
     Parameters
     ----------
     group : h5py.Group
     name : str
-    data : array_like
+    data : array_like or None
     **kwargs
-        Forwarded to :meth:`h5py.Group.create_dataset` (e.g. ``maxshape``, ``chunks``).
+        Forwarded to :meth:`h5py.Group.create_dataset` (e.g. ``maxshape``, ``chunks``,
+        ``shape`` and ``dtype`` with ``data=None``, ``fletcher32=False``).
 
     Returns
     -------
     h5py.Dataset
     """
+    if "fletcher32" not in kwargs:
+        shape = kwargs.get("shape", np.shape(data))
+        dtype = np.dtype(kwargs.get("dtype") or np.asarray(data).dtype)
+        kwargs["fletcher32"] = len(shape) > 0 and dtype.kind in _CHECKSUMMED_KINDS
     return group.create_dataset(name, data=data, track_times=False, **kwargs)
+
+
+def read_array(dataset, selection=()):
+    """Read ``dataset[selection]``, refusing damaged data.
+
+    Parameters
+    ----------
+    dataset : h5py.Dataset
+    selection : slice, tuple or int, optional
+        Default: everything.
+
+    Returns
+    -------
+    numpy.ndarray or scalar
+
+    Raises
+    ------
+    CorruptFileError
+        If HDF5 cannot read the data: a checksum (:func:`write_dataset`) or the
+        decompression of a chunk failed. The message names the file and dataset.
+        In a file being written (SWMR), where a chunk may be read while its writer
+        rewrites it, the read is tried :data:`_SWMR_READ_ATTEMPTS` times first.
+    """
+    attempts = _SWMR_READ_ATTEMPTS if dataset.file.swmr_mode else 1
+    for attempt in range(1, attempts + 1):
+        try:
+            return dataset[selection]
+        except OSError as error:
+            failure = error
+            if attempt < attempts:  # a running writer may be rewriting the chunk: read it again
+                time.sleep(0.1)
+                dataset.refresh()
+    raise CorruptFileError(f"{dataset.file.filename}: dataset {dataset.name} is damaged and cannot be read "
+                           f"({failure}); remake the file (rerun the job that wrote it)") from None
 
 
 def write_attrs(obj, attrs):
@@ -242,7 +297,7 @@ def read_table(group, name, rows=None):
     columns = json.loads(sub.attrs["columns"])
     data = {}
     for column in columns:
-        values = sub[column][:rows]
+        values = read_array(sub[column], slice(None, rows))
         if values.dtype.kind in "OS":
             values = np.asarray([v.decode() if isinstance(v, bytes) else v for v in values], dtype=object)
         data[column] = values
@@ -451,13 +506,13 @@ def copy_file(source, target, rows):
                                 maxshape=obj.maxshape, fletcher32=obj.fletcher32, compression=obj.compression,
                                 compression_opts=obj.compression_opts)
             if not shape:
-                out[()] = obj[()]
+                out[()] = read_array(obj)
             elif shape[0]:
                 chunk = obj.chunks[0] if obj.chunks else 1
                 row_bytes = max(1, obj.dtype.itemsize * int(np.prod(shape[1:])))
                 step = max(1, _COPY_BLOCK_BYTES // row_bytes // chunk) * chunk
                 for start in range(0, shape[0], step):
-                    out[start:start + step] = obj[start:min(start + step, shape[0])]
+                    out[start:start + step] = read_array(obj, slice(start, min(start + step, shape[0])))
             copy_attrs(obj, out)
 
     copy_group(source, target)

@@ -251,7 +251,7 @@ def read_timeseries(path):
         for name in _DATASETS:
             if name not in f:
                 _fail(source, name, "is missing (required dataset)")
-            data = f[name][...]
+            data = h5io.read_array(f[name])
             if data.dtype.kind not in "fiu":
                 _fail(source, name, f"must be numeric, got dtype {data.dtype}")
             values[name] = np.asarray(data, dtype=np.float64)

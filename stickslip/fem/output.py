@@ -33,7 +33,8 @@ import json
 import numpy as np
 
 from .. import __version__, formats
-from ..h5io import FileFormatError, atomic_output, copy_file, open_file, read_table, write_attrs, write_dataset
+from ..h5io import (FileFormatError, atomic_output, copy_file, open_file, read_array, read_table, write_attrs,
+                    write_dataset)
 from ..mesh import load_mesh, save_mesh
 from ..params import parse_params
 from .parameters import FemParams
@@ -172,8 +173,8 @@ class RunFile:
         if not 0 <= increment < self.nstored:
             raise FileFormatError(f"{self.file.filename}: increment {increment} is not stored "
                                   f"(0 ... {self.nstored - 1})")
-        s = self.file["state"]
-        return s["u"][increment], s["target"][increment], float(s["lever_target"][increment]), float(s["t"][increment])
+        u, target, lever_target, t = (read_array(self.file["state"][name], increment) for name in _STATE)
+        return u, target, float(lever_target), float(t)
 
     def increment_bytes(self):
         """Bytes that appending one increment may allocate at most: one new chunk of every growing dataset [B]."""
@@ -184,7 +185,9 @@ class RunFile:
     def linear_response(self):
         """(delta_u, delta_eps, delta_target, delta_lever) as stored."""
         e = self.file["event"]
-        return e["delta_u"][...], e["delta_eps"][...], e["delta_target"][...], float(e["delta_lever"][0])
+        delta_u, delta_eps, delta_target, delta_lever = (
+            read_array(e[name]) for name in ("delta_u", "delta_eps", "delta_target", "delta_lever"))
+        return delta_u, delta_eps, delta_target, float(delta_lever[0])
 
 
 def read_increments(path):

@@ -9,7 +9,7 @@ Layout of a mesh group: datasets ``coor`` [nnode, 2], ``conn`` [nelem, 4],
 from pathlib import Path
 
 from .. import formats
-from ..h5io import FileFormatError, atomic_output, open_file, write_attrs, write_dataset
+from ..h5io import FileFormatError, atomic_output, open_file, read_array, write_attrs, write_dataset
 from ..hashing import short_hash
 from ..params import ParameterError, params_to_dict, parse_params
 from .layered import LayeredMesh, MeshParams, build_stack_mesh
@@ -76,7 +76,7 @@ def load_mesh(group):
     if int(group.attrs["mesh_format"]) != MESH_FORMAT:
         raise FileFormatError(f"{where}: mesh_format {group.attrs['mesh_format']} is not the supported "
                               f"{MESH_FORMAT}; rebuild the mesh")
-    arrays = {name: group[name][...] for name in _DATASETS}
+    arrays = {name: read_array(group[name]) for name in _DATASETS}
     for name, rank in _DATASETS.items():
         if arrays[name].ndim != rank:
             raise FileFormatError(f"{where}/{name}: expected {rank} dimensions, got shape {arrays[name].shape}")

@@ -26,7 +26,7 @@ from ..h5io import FileFormatError, atomic_output
 from ..hashing import sha256_file
 from ..lineage import Artifact
 
-__all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "file_entry", "git_state",
+__all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "file_entry", "check_recorded_sha256", "git_state",
            "library_versions", "peak_memory_mib", "write_record", "read_record", "recording"]
 
 #: Version of the record layout; bump when fields change meaning. 2: file entries carry lineage
@@ -204,8 +204,43 @@ def _job_record(*, run_id, kind, plugin, plugin_version, code_hash, params, thre
         "plugin_version": plugin_version, "code_hash": code_hash, "package_version": _package_version(),
         "git_commit": commit, "git_dirty": dirty, "params": params, "seed": params.get("seed"),
         "threads": threads, "versions": library_versions(), "host": socket.gethostname(),
-        "inputs": [file_entry(role, path) for role, path in inputs],
+        "inputs": [_input_entry(role, path) for role, path in inputs],
     }
+
+
+def _input_entry(role, path):
+    """:func:`file_entry` of an input, checked against the record of the job that wrote it."""
+    entry = file_entry(role, path)
+    check_recorded_sha256(path, entry["sha256"])
+    return entry
+
+
+def check_recorded_sha256(path, sha256):
+    """Raise if the provenance record beside ``path`` states another sha256 for it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A file some job wrote (its record: :func:`record_path`); files without a
+        record (lab data, files made by hand) are not checked.
+    sha256 : str
+        The file's sha256 now.
+
+    Raises
+    ------
+    FileFormatError
+        If the record lists the file with another sha256: it was damaged or changed
+        after the job wrote it.
+    """
+    path = Path(path)
+    record = record_path(path)
+    if not record.is_file():
+        return
+    for entry in read_record(record)["outputs"]:
+        if Path(entry["path"]).name == path.name and entry["sha256"] != sha256:
+            raise FileFormatError(
+                f"{path}: sha256 {sha256[:16]}... differs from {entry['sha256'][:16]}... recorded in {record} "
+                f"when it was written; the file was damaged or changed since: delete it and rerun the job that makes it")
 
 
 @contextmanager
