@@ -2,9 +2,11 @@
 
 import io
 import json
+import os
 from contextlib import redirect_stdout
 
 import pandas as pd
+import pytest
 
 from stickslip.cli import main
 
@@ -67,3 +69,35 @@ def test_db_sql_only_reads(toy_results, capsys, tmp_path):
     status, text = _run("db", "sql", "WITH RECURSIVE r(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM r WHERE i < 3) "
                                      "SELECT SUM(i) AS s FROM r", "--format", "csv")
     assert status == 0 and text.splitlines() == ["s", "6"]
+
+
+def test_database_mode_schema_version_and_wrong_files(toy_results, capsys, tmp_path):
+    import sqlite3
+    import stat
+
+    assert _run("db", "rebuild")[0] == 0
+    database = tmp_path / "results" / "default" / "stickslip.sqlite"
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(database.stat().st_mode) == 0o666 & ~umask  # a group can read it if the umask lets it
+    assert not [p.name for p in database.parent.iterdir() if p.name.endswith(".tmp")]
+    with sqlite3.connect(database) as connection:
+        connection.execute("UPDATE schema_info SET value = '1' WHERE key = 'schema_version'")
+    capsys.readouterr()
+    for command in (["runs"], ["events"], ["sql", "SELECT 1"]):
+        status, text = _run("db", *command)
+        err = capsys.readouterr().err
+        assert status == 2 and err.count("\n") == 1 and "schema version 1, expected" in err
+        assert "stickslip db rebuild" in err
+    lab = tmp_path / "lab.h5"
+    lab.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
+    assert _run("db", "runs", "--db", str(lab))[0] == 2
+    assert capsys.readouterr().err == f"stickslip: error: {lab}: query failed: file is not a database\n"
+
+
+def test_every_db_command_describes_itself():
+    for command in ("runs", "events", "sql", "ingest", "rebuild"):
+        out = io.StringIO()
+        with redirect_stdout(out), pytest.raises(SystemExit):
+            main(["db", command, "--help"])
+        assert out.getvalue().split("\n\n")[1].strip()[0].isupper()  # the paragraph after the usage

@@ -82,3 +82,12 @@ def test_a_full_run_takes_well_under_a_second():
     assert record.t_F[-1] == 6000.0 and len(truth) > 300
     assert elapsed < 1.5  # measured ~0.3-0.5 s on the shared 2-core machine
     assert np.all(np.isfinite(record.F))
+
+
+@pytest.mark.parametrize("threads", ["0", "-1", "two"])
+def test_a_thread_count_below_one_is_a_usage_error(threads, tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["simulate", "--solver", "lever", "--threads", threads, "-o", str(tmp_path / "x.h5")])
+    assert stop.value.code == 2
+    assert f"argument --threads: expected an integer >= 1, got '{threads}'" in capsys.readouterr().err
+    assert not (tmp_path / "x.h5").exists()

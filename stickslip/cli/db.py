@@ -48,7 +48,11 @@ def add_parser(subparsers):
                                    description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="db_command", required=True, metavar="DB_COMMAND")
 
-    runs = commands.add_parser("runs", help="list runs with their parameters")
+    def command(name, summary):
+        """A sub-command whose ``--help`` starts with its one-line summary."""
+        return commands.add_parser(name, help=summary, description=summary[0].upper() + summary[1:] + ".")
+
+    runs = command("runs", "list runs with their parameters")
     _common(runs)
     runs.add_argument("--kind", choices=("solver", "analysis", "figure", "mesh"))
     runs.add_argument("--plugin")
@@ -58,7 +62,7 @@ def add_parser(subparsers):
     runs.add_argument("--seed", type=int)
     runs.set_defaults(func=run_runs)
 
-    events = commands.add_parser("events", help="list slip events with their simulation's parameters")
+    events = command("events", "list slip events with their simulation's parameters")
     _common(events)
     events.add_argument("--solver")
     events.add_argument("--analysis")
@@ -70,17 +74,17 @@ def add_parser(subparsers):
     events.add_argument("--run-id", help="one simulation")
     events.set_defaults(func=run_events)
 
-    sql = commands.add_parser("sql", help="run SQL on a read-only connection")
+    sql = command("sql", "run SQL on a read-only connection")
     _common(sql)
     sql.add_argument("query", help='e.g. "SELECT n, COUNT(*) FROM simulations GROUP BY n"')
     sql.set_defaults(func=run_sql)
 
-    ingest = commands.add_parser("ingest", help="add provenance records to the database (idempotent)")
+    ingest = command("ingest", "add provenance records to the database (idempotent)")
     ingest.add_argument("records", nargs="+", type=Path, help="*.provenance.json files")
     _database_options(ingest)
     ingest.set_defaults(func=run_ingest)
 
-    rebuild = commands.add_parser("rebuild", help="recreate the database from every record under the results")
+    rebuild = command("rebuild", "recreate the database from every record under the results")
     _database_options(rebuild)
     rebuild.add_argument("--results", type=Path, default=None,
                          help="results tree whose records to read (default results/STUDY)")
@@ -109,34 +113,33 @@ def _write(frame, args, columns):
             print(frame.to_string(index=False))
 
 
-def run_runs(args):
-    """``db runs``."""
+def _query(args, name, columns=None, *positional, **filters):
+    """Run ``query.<name>`` on the database of ``args`` and print it; a failed query is one line, exit 2."""
     from ..provenance import query
 
-    frame = query.runs(_database(args), kind=args.kind, plugin=args.plugin, solver=args.solver, n=args.n,
-                       regime=args.regime, seed=args.seed)
-    return _print(frame, args, RUN_COLUMNS)
+    try:
+        frame = getattr(query, name)(*positional, _database(args), **filters)
+    except query.QueryError as error:
+        print(f"stickslip: error: {error}", file=sys.stderr)
+        return 2
+    return _print(frame, args, columns)
+
+
+def run_runs(args):
+    """``db runs``."""
+    return _query(args, "runs", RUN_COLUMNS, kind=args.kind, plugin=args.plugin, solver=args.solver, n=args.n,
+                  regime=args.regime, seed=args.seed)
 
 
 def run_events(args):
     """``db events``."""
-    from ..provenance import query
-
-    frame = query.events(_database(args), solver=args.solver, analysis=args.analysis, source=args.source, n=args.n,
-                         interface=args.interface, regime=args.regime, seed=args.seed, run_id=args.run_id)
-    return _print(frame, args, EVENT_COLUMNS)
+    return _query(args, "events", EVENT_COLUMNS, solver=args.solver, analysis=args.analysis, source=args.source,
+                  n=args.n, interface=args.interface, regime=args.regime, seed=args.seed, run_id=args.run_id)
 
 
 def run_sql(args):
     """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2."""
-    from ..provenance import query
-
-    try:
-        frame = query.sql(args.query, _database(args))
-    except query.QueryError as error:
-        print(f"stickslip: error: {error}", file=sys.stderr)
-        return 2
-    return _print(frame, args)
+    return _query(args, "sql", None, args.query)
 
 
 def run_ingest(args):

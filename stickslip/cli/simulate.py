@@ -1,5 +1,6 @@
 """``stickslip simulate``: run one solver on parameters given as KEY=VALUE."""
 
+import argparse
 from pathlib import Path
 
 from .. import registry
@@ -17,9 +18,20 @@ def add_parser(subparsers):
     parser.add_argument("--solver", required=True, help="solver plugin name (see `stickslip plugins`)")
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                         help="one parameter (repeat); the others keep their defaults")
-    parser.add_argument("--threads", type=int, default=1, help="threads for parallel kernels (default 1)")
+    parser.add_argument("--threads", type=positive_int, default=1, help="threads for parallel kernels (default 1)")
     parser.add_argument("-o", "--output", required=True, type=Path, help="output file (HDF5)")
     parser.set_defaults(func=run)
+
+
+def positive_int(text):
+    """An argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
+    return value
 
 
 def run(args):

@@ -20,9 +20,7 @@ carry, never file names, and needs no edit for a new solver or analysis:
 
 import fcntl
 import json
-import os
 import shutil
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -31,7 +29,7 @@ from sqlalchemy.orm import Session
 
 from .. import formats, registry
 from ..formats import event_table
-from ..h5io import FileFormatError
+from ..h5io import FileFormatError, atomic_output
 from ..progress import iterate
 from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
@@ -200,26 +198,16 @@ def ingest(database, records, *, rebuild=False):
     database = Path(database)
     database.parent.mkdir(parents=True, exist_ok=True)
     records = [Path(r) for r in records]
-    with _locked(database):
-        fd, tmp = tempfile.mkstemp(prefix=f".{database.name}.", suffix=".tmp", dir=database.parent)
-        os.close(fd)
-        tmp = Path(tmp)
+    with _locked(database), atomic_output(database) as tmp:  # an empty file is an empty SQLite database
+        if database.exists() and not rebuild:
+            shutil.copyfile(database, tmp)
+        engine = engine_for(tmp)
         try:
-            if database.exists() and not rebuild:
-                shutil.copyfile(database, tmp)
-            else:
-                tmp.unlink()
-            engine = engine_for(tmp)
-            try:
-                create_schema(engine, __version__)
-                events = 0
-                with Session(engine) as session, session.begin():
-                    for record_file in iterate(records, desc="ingest", unit="record"):
-                        events += _ingest_record(session, read_record(record_file), record_file)
-            finally:
-                engine.dispose()
-            os.replace(tmp, database)
+            create_schema(engine, __version__)
+            events = 0
+            with Session(engine) as session, session.begin():
+                for record_file in iterate(records, desc="ingest", unit="record"):
+                    events += _ingest_record(session, read_record(record_file), record_file)
         finally:
-            if tmp.exists():
-                tmp.unlink()
+            engine.dispose()
     return {"records": len(records), "slip events": events}

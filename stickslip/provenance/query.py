@@ -13,7 +13,7 @@ import sqlalchemy.exc
 from sqlalchemy import select, text
 
 from ..h5io import FileFormatError
-from .database import Figure, Run, Simulation, engine_for
+from .database import SCHEMA_VERSION, Figure, Run, Simulation, engine_for
 
 __all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "runs", "events", "figures", "sql"]
 
@@ -52,10 +52,19 @@ def _only_reading(action, name, argument, _database, _trigger):
     return sqlite3.SQLITE_DENY
 
 
+def _check_schema(database, connection):
+    """Raise QueryError unless the database has this package's schema version."""
+    found = connection.execute(text("SELECT value FROM schema_info WHERE key = 'schema_version'")).scalar()
+    if found is None or int(found) != SCHEMA_VERSION:
+        raise QueryError(f"{database}: database schema version {found}, expected {SCHEMA_VERSION}: "
+                         f"run `stickslip db rebuild`")
+
+
 def _frame(database, statement, only_reading=False):
     engine = _engine(database)
     try:
         with engine.connect() as connection:
+            _check_schema(database, connection)
             if only_reading:
                 connection.connection.driver_connection.set_authorizer(_only_reading)
             frame = pd.read_sql(statement, connection)
