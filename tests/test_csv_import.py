@@ -85,9 +85,12 @@ def test_declared_unit_must_agree_with_the_header(tmp_path):
         import_csv(*write(tmp_path), tmp_path / "run.h5", n=2, n_slabs=2, time_unit="ms")
 
 
-def test_inconsistent_metadata_is_rejected(tmp_path):
-    with pytest.raises(FileFormatError, match="'n' must be in 1..n_slabs=2"):
-        import_csv(*write(tmp_path), tmp_path / "run.h5", n=3, n_slabs=2)
+def test_inconsistent_metadata_is_rejected_naming_the_csv_files_not_the_output(tmp_path):
+    force, positions = write(tmp_path)
+    with pytest.raises(FileFormatError, match="'n' must be in 1..n_slabs=2") as error:
+        import_csv(force, positions, tmp_path / "run.h5", n=3, n_slabs=2)
+    assert str(error.value).startswith(f"import of {force} and {positions}: ")
+    assert not (tmp_path / "run.h5").exists()
 
 
 def test_cli(tmp_path, capsys):

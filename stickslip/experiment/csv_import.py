@@ -29,7 +29,7 @@ import pandas as pd
 
 from ..h5io import FileFormatError
 from ..hashing import sha256_file
-from .timeseries import ExperimentRecord, write_timeseries
+from .timeseries import ExperimentRecord, validate_record, write_timeseries
 
 __all__ = ["UNITS", "import_csv", "read_csv_columns"]
 
@@ -188,6 +188,7 @@ def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stac
     x = np.column_stack([positions[f"x{i}"] for i in range(1, n_slabs + 1)])
     record = ExperimentRecord(t_F=force["t"], F=force["F"], t_x=positions["t"], x=x, n=n, n_slabs=n_slabs,
                               protocol=protocol, a=a, normal_force=normal_force, k_spring=k_spring, h=h, H=H, V=V)
+    validate_record(record, source=f"import of {force_csv} and {positions_csv}")  # before naming the output
     source = {"force_csv": {"name": Path(force_csv).name, "sha256": sha256_file(force_csv)},
               "positions_csv": {"name": Path(positions_csv).name, "sha256": sha256_file(positions_csv)}}
     write_timeseries(output, record, attrs={"imported_from": source})
