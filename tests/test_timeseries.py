@@ -88,12 +88,12 @@ def _corrupt(path, edit):
 CORRUPTIONS = [
     (lambda f: f.__delitem__("x"), "'x' is missing (required dataset)"),
     (lambda f: f.attrs.__delitem__("k_spring"), "'k_spring' is missing (required attribute)"),
-    (lambda f: f.attrs.__setitem__("n", 1.5), "'n' must be an integer"),
+    (lambda f: f.attrs.__setitem__("n", 39.6), "'n' must be an integer, got 39.6"),  # not np.float64(39.6)
     (lambda f: (f.attrs.__setitem__("protocol", "individual"), f.attrs.__delitem__("a")),
      "'a' is missing (required attribute of the individual protocol: the driven slab)"),
     (lambda f: f.attrs.__setitem__("h", "ten"), "'h' must be a number"),
     (lambda f: f.attrs.__setitem__("protocol", "free"), "'protocol' must be one of"),
-    (lambda f: f["t_F"].__setitem__(3, 0.0), "'t_F' must be strictly increasing; sample 3"),
+    (lambda f: f["t_F"].__setitem__(3, 0.0), "'t_F' must be strictly increasing; sample 3 (0 s) does not follow"),
     (lambda f: f["x"].__setitem__((1, 1), np.nan), "'x' must be finite"),
 ]
 

@@ -126,6 +126,11 @@ def _fail(source, item, expected):
     raise h5io.FileFormatError(f"{source}: '{item}' {expected}")
 
 
+def _plain(value):
+    """A numpy scalar as the Python number it holds (shown ``39.6``, not ``np.float64(39.6)``)."""
+    return value.item() if isinstance(value, np.generic) else value
+
+
 def _check_times(source, name, times):
     if times.ndim != 1 or times.size < 2:
         _fail(source, name, f"must be a 1-D array of at least 2 times, got shape {times.shape}")
@@ -134,8 +139,8 @@ def _check_times(source, name, times):
     steps = np.diff(times)
     if np.any(steps <= 0):
         index = int(np.argmax(steps <= 0))
-        _fail(source, name, f"must be strictly increasing; sample {index + 1} ({times[index + 1]!r} s) "
-                            f"does not follow sample {index} ({times[index]!r} s)")
+        _fail(source, name, f"must be strictly increasing; sample {index + 1} ({times[index + 1]:.10g} s) "
+                            f"does not follow sample {index} ({times[index]:.10g} s)")
 
 
 def validate_record(record, source="record"):
@@ -171,7 +176,7 @@ def validate_record(record, source="record"):
     for name in _FLOAT_ATTRS:
         value = getattr(record, name)
         if not (np.isfinite(value) and value > 0):
-            _fail(source, name, f"must be a finite number > 0, got {value!r}")
+            _fail(source, name, f"must be a finite number > 0, got {float(value):g}")
     _check_times(source, "t_F", record.t_F)
     _check_times(source, "t_x", record.t_x)
     if record.F.shape != record.t_F.shape:
@@ -265,12 +270,12 @@ def read_timeseries(path):
         for name in _INT_ATTRS:
             value = f.attrs.get(name, 0)  # only a of a stack recording may be absent: 0
             if not (np.issubdtype(type(value), np.integer) or (isinstance(value, float) and value.is_integer())):
-                _fail(source, name, f"must be an integer, got {value!r}")
+                _fail(source, name, f"must be an integer, got {_plain(value)!r}")
             values[name] = int(value)
         for name in _FLOAT_ATTRS:
             value = f.attrs[name]
             if not np.issubdtype(type(value), np.number) or np.ndim(value) != 0:
-                _fail(source, name, f"must be a number, got {value!r}")
+                _fail(source, name, f"must be a number, got {_plain(value)!r}")
             values[name] = float(value)
     record = ExperimentRecord(**values)
     validate_record(record, source=source)
