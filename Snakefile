@@ -3,7 +3,7 @@
 # (it replaces the default config, it is not merged with it). Each study writes under results/{study}/
 # (the config's `study` key, default: the config file's stem). See docs/workflow.md.
 
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
 
 min_version("9.0")
 
@@ -11,9 +11,6 @@ min_version("9.0")
 if not workflow.overwrite_configfiles:
 
     configfile: "workflow/config/default.yaml"
-
-
-validate(config, "workflow/schemas/config.schema.yaml")
 
 
 include: "workflow/rules/common.smk"

@@ -1,16 +1,35 @@
 # The study: the config validated (each plugin section against its plugin's JSON-Schema, defaults
 # filled) and expanded into jobs by stickslip.study before any rule is defined.
 
+import re
 import tempfile
 from pathlib import Path
 
 import yaml
 from snakemake.exceptions import WorkflowError
+from snakemake.utils import validate
 
 from stickslip.params import ParameterError
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
 from stickslip.study import Study, check_sweeps, normalise, plugin_sections
+
+
+def _validate(section, schema, key):
+    """Validate against a JSON-Schema file (defaults filled in); a failure is one message naming the key.
+
+    jsonschema's message is followed by the whole schema that failed (a hundred lines for a plugin
+    section): only its first paragraph is kept.
+    """
+    try:
+        validate(section, schema)
+    except WorkflowError as error:
+        detail = str(error.args[0]).removeprefix("Error validating config file.").strip()
+        instance = re.search(r"^On instance((?:\[[^\]]*\])*):", detail, re.M)
+        for item in re.findall(r"\[([^\]]*)\]", instance.group(1) if instance else ""):
+            key = f"{key}.{item.strip(chr(39))}" if item.startswith("'") else f"{key}[{item}]"
+        message = detail.split("\n\n")[0].removeprefix("ValidationError: ")
+        raise WorkflowError(f"config key {key.lstrip('.')}: {message}") from None
 
 
 def _validate_plugin_sections(config):
@@ -22,14 +41,11 @@ def _validate_plugin_sections(config):
             # one file per section: Snakemake caches a schema file's contents by path
             path = Path(folder) / f"section{index}.schema.yaml"
             path.write_text(yaml.safe_dump({"$schema": "https://json-schema.org/draft/2020-12/schema", **schema}))
-            try:
-                validate(section, str(path))
-            except WorkflowError as error:
-                detail = str(error.args[0]).removeprefix("Error validating config file.").strip()
-                raise WorkflowError(f"config key {key}: {detail}") from None
+            _validate(section, str(path), key)
 
 
 try:
+    _validate(config, "../schemas/config.schema.yaml", "")
     _validate_plugin_sections(config)
     STUDY = Study(config, workflow.configfiles)
 except ParameterError as error:
