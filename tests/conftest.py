@@ -3,6 +3,7 @@
 import json
 import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -100,3 +101,17 @@ def toy_results(tmp_path, toy_plugins, monkeypatch):
                "results/default/figures/toy-force.provenance.json", "results/default/logs/figure.log")
     records.append(Path("results/default/figures/toy-force.provenance.json"))
     return records
+
+
+@pytest.fixture(scope="session")
+def ci_study():
+    """The real ci study (workflow/config/ci.yaml) run once with `snakemake --cores 2`; returns its directory.
+
+    Shared by the smoke test and the SLURM test (which compares its own run with this one).
+    """
+    from test_workflow import snakemake
+
+    directory = copy_workflow(Path(tempfile.mkdtemp(prefix="stickslip-ci-study-")))
+    snakemake(directory, "--cores", "2", "--configfile", "workflow/config/ci.yaml")
+    yield directory
+    shutil.rmtree(directory, ignore_errors=True)

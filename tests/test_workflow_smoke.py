@@ -6,18 +6,17 @@ import sqlite3
 import pytest
 import yaml
 
-from conftest import REPO, copy_workflow
+from conftest import REPO
 from stickslip.provenance.record import REQUIRED_FIELDS, read_record
 from stickslip.study import Study
 from test_workflow import snakemake
 
 
 @pytest.mark.slow
-def test_ci_study_end_to_end(tmp_path):
-    directory = copy_workflow(tmp_path)
+def test_ci_study_end_to_end(ci_study):
+    directory = ci_study
     study = Study(yaml.safe_load((REPO / "workflow" / "config" / "ci.yaml").read_text()), ["ci.yaml"])
     assert {sim.solver for sim in study.simulations} >= {"lever", "fem"}
-    snakemake(directory, "--cores", "2", "--configfile", "workflow/config/ci.yaml")
     results = directory / "results" / "ci"
     for path in study.outputs():
         assert (directory / path).stat().st_size > 0, path

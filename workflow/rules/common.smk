@@ -67,3 +67,16 @@ def record_of(pattern):
     """The provenance record beside an output pattern."""
     return record_path(pattern).as_posix()
 
+
+onstart:
+    # A SLURM run checks, before submitting anything, that it would not hang (stickslip.cluster).
+    if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
+        from stickslip.cluster import JobRequest, SlurmSetupError, check_slurm
+
+        requests = [JobRequest(job.rule.name, job.threads, job.resources.get("mem_mb"),
+                               job.resources.get("slurm_partition") or None)
+                    for job in workflow.dag.needrun_jobs() if not job.is_local]
+        try:
+            check_slurm(workflow.executor_settings.status_command, requests)
+        except SlurmSetupError as error:
+            raise WorkflowError(f"SLURM: {error}") from None

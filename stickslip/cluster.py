@@ -1,0 +1,168 @@
+"""Checks of the SLURM path before any job is submitted, so that a run fails with a message instead of hanging.
+
+Two ways a SLURM run of the workflow used to wait forever without a word:
+
+- the executor plugin (snakemake-executor-plugin-slurm 2.8.0) learns that a job ended from its status
+  command, ``sacct`` by default; on a cluster without an accounting database ``sacct`` fails ("Slurm
+  accounting storage is disabled") and finished jobs are never noticed. ``squeue`` works there, as long
+  as finished jobs stay in it (``MinJobAge``); with ``MinJobAge`` below 120 s the plugin falls back to
+  ``sacct`` whenever ``sacct`` is installed;
+- a job that asks for more CPUs or memory than any node of its partition has stays pending
+  (``PD (PartitionConfig)``) on clusters that do not refuse it at submission.
+
+:func:`check_slurm` runs both checks (``sacct``, ``scontrol show config``, ``sinfo``) from the workflow's
+``onstart`` handler and raises :class:`SlurmSetupError` with what to change.
+"""
+
+import dataclasses
+import re
+import shutil
+import subprocess
+
+__all__ = ["SlurmSetupError", "JobRequest", "STATUS_SWITCH", "check_slurm", "status_command_problem",
+           "request_problem"]
+
+#: The command-line switch (and profile key ``slurm-status-command``) for clusters without accounting.
+STATUS_SWITCH = "--slurm-status-command squeue"
+
+#: The plugin falls back from ``squeue`` to ``sacct`` when ``MinJobAge`` is below this [s] (3 x its
+#: first status-check delay of 40 s).
+SQUEUE_MIN_JOB_AGE = 120
+
+
+class SlurmSetupError(RuntimeError):
+    """The cluster cannot run the workflow as configured; the message says what to change."""
+
+
+@dataclasses.dataclass(frozen=True)
+class JobRequest:
+    """What one job asks of SLURM.
+
+    Attributes
+    ----------
+    rule : str
+    threads : int
+        CPUs per task.
+    mem_mb : int or None
+        Memory [MB]; None if the job states none.
+    partition : str or None
+        ``slurm_partition``; None: the cluster's default partition.
+    """
+
+    rule: str
+    threads: int
+    mem_mb: int | None
+    partition: str | None
+
+
+def _run(*command):
+    """Run a SLURM client command; return (exit status, stdout, first line of stderr)."""
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=60, check=False)
+    except FileNotFoundError:
+        return 127, "", f"{command[0]}: command not found"
+    except subprocess.TimeoutExpired:
+        return 124, "", f"{' '.join(command)}: no answer within 60 s"
+    lines = done.stderr.strip().splitlines()
+    return done.returncode, done.stdout, (lines[0] if lines else "")
+
+
+def _min_job_age():
+    """``MinJobAge`` of the controller [s], or None if it cannot be read."""
+    status, out, _ = _run("scontrol", "show", "config")
+    found = re.search(r"^\s*MinJobAge\s*=\s*(\d+)", out, re.M) if status == 0 else None
+    return int(found[1]) if found else None
+
+
+def status_command_problem(status_command):
+    """Return why the plugin's status command would not see jobs finish on this cluster, or None.
+
+    Parameters
+    ----------
+    status_command : {"sacct", "squeue"}
+        The plugin's setting ``slurm-status-command``.
+
+    Returns
+    -------
+    str or None
+        One line: what fails and the switch to use.
+    """
+    min_job_age = _min_job_age()
+    used = status_command
+    if status_command == "squeue" and shutil.which("sacct") and (min_job_age or 0) < SQUEUE_MIN_JOB_AGE:
+        used = "sacct"
+    if used == "sacct":
+        status, _, error = _run("sacct", "--noheader", "--allocations", "--starttime", "now")
+        if status != 0:
+            if status_command == "squeue":
+                return (f"the SLURM status command falls back to sacct because MinJobAge = {min_job_age} s is "
+                        f"below {SQUEUE_MIN_JOB_AGE} s, and sacct fails on this cluster ({error}): ask for a "
+                        f"MinJobAge of at least {SQUEUE_MIN_JOB_AGE} s in slurm.conf")
+            return (f"the SLURM status command sacct fails on this cluster ({error}), so finished jobs would never "
+                    f"be noticed: without an accounting database run with {STATUS_SWITCH}")
+    return None
+
+
+def _nodes(partition):
+    """(CPUs, memory [MB]) of every node of a partition (None: the default partition), from sinfo."""
+    if partition is None:
+        status, out, error = _run("sinfo", "--noheader", "--format", "%P")
+        defaults = [name[:-1] for name in out.split() if name.endswith("*")]
+        if status != 0 or not defaults:
+            raise SlurmSetupError(f"sinfo names no default partition ({error or out.strip()}): set slurm_partition "
+                                  "(README, 'Running on a SLURM cluster')")
+        partition = defaults[0]
+    status, out, error = _run("sinfo", "--noheader", "--Node", "--partition", partition, "--format", "%c %m")
+    nodes = [tuple(int(value.rstrip("+")) for value in line.split()) for line in out.splitlines() if line.strip()]
+    if status != 0 or not nodes:
+        raise SlurmSetupError(f"partition '{partition}': sinfo lists no node ({error or 'empty answer'}); "
+                              "set slurm_partition to a partition of this cluster (sinfo lists them)")
+    return partition, nodes
+
+
+def request_problem(jobs):
+    """Return the first job that no node of its partition can run, as one line, or None.
+
+    Parameters
+    ----------
+    jobs : Iterable[JobRequest]
+
+    Returns
+    -------
+    str or None
+    """
+    nodes = {}
+    for job in jobs:
+        if job.partition not in nodes:
+            nodes[job.partition] = _nodes(job.partition)
+        partition, sizes = nodes[job.partition]
+        cpus = max(size[0] for size in sizes)
+        if job.threads > cpus:
+            return (f"rule {job.rule} asks for {job.threads} CPUs per job, but the largest node of partition "
+                    f"'{partition}' has {cpus}: the job would stay pending; set the config key threads to at "
+                    f"most {cpus} (--config threads={cpus})")
+        fitting = [memory for count, memory in sizes if count >= job.threads]
+        if job.mem_mb is not None and job.mem_mb > max(fitting):
+            return (f"rule {job.rule} asks for {job.mem_mb} MB, but the nodes of partition '{partition}' with "
+                    f"{job.threads} CPUs have at most {max(fitting)} MB: the job would stay pending; lower "
+                    f"mem_mb of {job.rule} (set-resources in the profile)")
+    return None
+
+
+def check_slurm(status_command, jobs):
+    """Check the status command and every job's request against the cluster.
+
+    Parameters
+    ----------
+    status_command : {"sacct", "squeue"}
+    jobs : Iterable[JobRequest]
+        The jobs about to be submitted.
+
+    Raises
+    ------
+    SlurmSetupError
+        With one line saying what to change.
+    """
+    problem = status_command_problem(status_command) or request_problem(jobs)
+    if problem:
+        raise SlurmSetupError(problem)

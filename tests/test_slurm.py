@@ -1,0 +1,111 @@
+"""The SLURM path against a real controller: a single-node slurmctld + slurmd on loopback (tests/slurm/cluster.sh).
+
+The ci study runs through the SLURM profile (every job through sbatch) on a cluster without an
+accounting database, and gives the same HDF5 files and database as a local run. With the wrong status
+command, or more CPUs per job than the node has, the workflow stops at start with a message instead of
+hanging. Every snakemake run is under a timeout: a hang fails the test.
+
+Needs root and Debian's SLURM packages (tests/slurm/packages.txt; `bash .ci/run` installs them); skipped
+with the reason otherwise (failed instead where STICKSLIP_REQUIRE_SLURM is set, as .ci/run does).
+"""
+
+import os
+import signal
+import sqlite3
+import subprocess
+from pathlib import Path
+
+import pytest
+import yaml
+
+from conftest import REPO, copy_workflow, python_path
+from stickslip.study import Study
+
+CLUSTER = REPO / "tests" / "slurm" / "cluster.sh"
+CI = ["--configfile", "workflow/config/ci.yaml"]
+#: The profile, the accounting-less cluster's status command, status checks every few seconds.
+SLURM = ["--workflow-profile", "profiles/slurm", "--slurm-status-command", "squeue",
+         "--slurm-init-seconds-before-status-checks", "5"]
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    """Environment of a running single-node cluster (SLURM_CONF, the partition 'stickslip' for the jobs)."""
+    directory = tmp_path_factory.mktemp("slurm")
+    started = subprocess.run(["bash", str(CLUSTER), "start", str(directory)], capture_output=True, text=True,
+                             timeout=180, check=False)
+    if started.returncode == 3:
+        if os.environ.get("STICKSLIP_REQUIRE_SLURM"):  # set by .ci/run where it installed the packages
+            pytest.fail(started.stderr.strip())
+        pytest.skip(started.stderr.strip())
+    assert started.returncode == 0, started.stdout + started.stderr
+    env = dict(os.environ, SLURM_CONF=str(directory / "slurm.conf"), STICKSLIP_SLURM_PARTITION="stickslip",
+               PYTHONPATH=python_path())
+    yield env
+    subprocess.run(["bash", str(CLUSTER), "stop", str(directory)], timeout=120, check=False)
+
+
+def run_snakemake(directory, env, *args, timeout):
+    """Run snakemake; on a timeout kill it with its whole process group and fail."""
+    process = subprocess.Popen(["snakemake", *args], cwd=directory, env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    try:
+        output, _ = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        output, _ = process.communicate()
+        pytest.fail(f"snakemake {' '.join(args)} still running after {timeout} s (a hang):\n{output[-4000:]}")
+    return process.returncode, output
+
+
+def slurm_jobs(env):
+    """SLURM jobs the controller knows (finished ones stay for MinJobAge): job id -> (partition, state)."""
+    out = subprocess.run(["squeue", "--noheader", "--states=all", "--format", "%i %P %T"], env=env,
+                         capture_output=True, text=True, timeout=60, check=True).stdout
+    return {line.split()[0]: tuple(line.split()[1:]) for line in out.splitlines()}
+
+
+def table(database, query):
+    with sqlite3.connect(database) as connection:
+        return sorted(connection.execute(query).fetchall())
+
+
+def test_ci_study_through_slurm_equals_the_local_run(cluster, ci_study, tmp_path):
+    local, remote = ci_study, copy_workflow(tmp_path)
+    before = slurm_jobs(cluster)
+    status, output = run_snakemake(remote, cluster, *SLURM, *CI, timeout=1200)
+    assert status == 0, output[-4000:]
+    study = Study(yaml.safe_load((REPO / "workflow" / "config" / "ci.yaml").read_text()), ["ci.yaml"])
+    submitted = {job: state for job, state in slurm_jobs(cluster).items() if job not in before}
+    # every job went through sbatch, into the partition named once in the environment, and completed
+    assert len(submitted) == (len(study.meshes) + len(study.simulations) + len(study.analysis_jobs)
+                              + len(study.figures) + 1)
+    assert set(submitted.values()) == {("stickslip", "COMPLETED")}
+    for path in study.outputs():
+        if path.endswith(".h5"):
+            assert (remote / path).read_bytes() == (local / path).read_bytes(), path
+    for query in ("SELECT run_id, kind, plugin FROM runs", "SELECT * FROM simulations",
+                  "SELECT analysis_run_id, event, interface, slip, dmu, time, increment FROM slip_events"):
+        assert table(remote / study.path("database"), query) == table(local / study.path("database"), query)
+    again, output = run_snakemake(remote, cluster, *SLURM, *CI, "-n", timeout=300)
+    assert again == 0 and "Nothing to be done" in output
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--slurm-status-command", "sacct"],
+     "SLURM: the SLURM status command sacct fails on this cluster (Slurm accounting storage is disabled), so "
+     "finished jobs would never be noticed: without an accounting database run with --slurm-status-command squeue"),
+    (["--config", "threads=64"],
+     "SLURM: rule simulate asks for 64 CPUs per job, but the largest node of partition 'stickslip' has"),
+    (["--set-resources", "simulate:mem_mb=100000000"],
+     "SLURM: rule simulate asks for 100000000 MB, but the nodes of partition 'stickslip' with 1 CPUs have at most"),
+])
+def test_a_setup_that_would_hang_stops_at_start(cluster, tmp_path, args, message):
+    directory = copy_workflow(tmp_path)
+    before = slurm_jobs(cluster)
+    status, output = run_snakemake(directory, cluster, *SLURM, *CI, *args, timeout=300)
+    assert status != 0
+    assert message in " ".join(output.split()), output[-4000:]
+    assert slurm_jobs(cluster) == before  # nothing was submitted
