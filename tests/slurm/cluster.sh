@@ -10,6 +10,14 @@
 # (the test skips with that reason); any other failure is an error. Everything lives in DIR: munge key and
 # socket, state, spool, logs, ports chosen free at start. No accounting database (accounting_storage/none,
 # as on clusters without slurmdbd): `sacct` answers from slurmctld for finished jobs within MinJobAge only.
+#
+# The one thing outside DIR is the link /run/slurm/conf -> DIR, removed at stop. Inside each job the jobstep
+# executor plugin (snakemake-executor-plugin-slurm-jobstep 0.6.1) runs `srun` with every SLURM_* variable
+# but the job's identity removed, SLURM_CONF included; srun then reads /etc/slurm/slurm.conf or else
+# /run/slurm/conf/slurm.conf, where a configless slurmd offers the controller's configuration to the
+# node's client commands. The link puts DIR/slurm.conf there. (A configless slurmd itself cannot run
+# here: it fetches the configuration before it reads AuthInfo, so it needs munge on the machine's default
+# socket.) Hence: not where /etc/slurm/slurm.conf exists, and one such cluster per machine at a time.
 set -euo pipefail
 
 cannot() { echo "cannot run a SLURM cluster here: $*" >&2; exit 3; }
@@ -20,6 +28,9 @@ dir=${2:-}
 
 # a process that exists and is not a zombie (a daemon's exit is reaped by init, maybe late)
 alive() { [[ -r /proc/$1/stat ]] && [[ "$(cut -d ' ' -f 3 "/proc/$1/stat" 2>/dev/null)" != Z ]]; }
+
+#: where client commands on a configless node find the configuration (see above)
+node_conf=/run/slurm/conf
 
 stop() {
     local pidfile pids=()
@@ -35,9 +46,11 @@ stop() {
     for pid in "${pids[@]}"; do
         for _ in $(seq 50); do alive "$pid" || break; sleep 0.1; done
     done
+    if [[ -L "$node_conf" && "$(readlink "$node_conf")" == "$dir" ]]; then rm -f "$node_conf"; fi
 }
 
 if [[ "$command" == stop ]]; then
+    if [[ -d "$dir" ]]; then dir=$(cd "$dir" && pwd); fi
     stop
     exit 0
 fi
@@ -47,6 +60,17 @@ fi
 for program in munged slurmctld slurmd sbatch squeue sinfo scontrol; do
     command -v "$program" >/dev/null || cannot "$program not found (apt-get install slurmctld slurmd slurm-client munge)"
 done
+
+[[ ! -e /etc/slurm/slurm.conf ]] || cannot "this machine has its own SLURM configuration (/etc/slurm/slurm.conf), which srun in the jobs would read instead of the test cluster's"
+if [[ -L "$node_conf" ]]; then
+    other=$(readlink "$node_conf")
+    if [[ -s "$other/run/slurmctld.pid" ]] && alive "$(cat "$other/run/slurmctld.pid")"; then
+        cannot "another test cluster is running ($node_conf -> $other; stop it with: $0 stop $other)"
+    fi
+    rm -f "$node_conf"  # left by a cluster that was not stopped
+elif [[ -e "$node_conf" ]]; then
+    cannot "$node_conf exists (a configless slurmd runs on this machine)"
+fi
 
 free_port() { python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
 
@@ -101,6 +125,8 @@ PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
 PartitionName=stickslip Nodes=$host Default=NO MaxTime=INFINITE State=UP
 EOF
 
+mkdir -p "$(dirname "$node_conf")"
+ln -s "$dir" "$node_conf"
 export SLURM_CONF="$dir/slurm.conf"
 slurmctld -f "$SLURM_CONF"
 slurmd -f "$SLURM_CONF"
