@@ -5,7 +5,8 @@ Two ways a SLURM run of the workflow used to wait forever without a word:
 - the executor plugin (snakemake-executor-plugin-slurm 2.8.0) learns that a job ended from its status
   command, ``sacct`` by default; on a cluster without an accounting database ``sacct`` fails ("Slurm
   accounting storage is disabled") and finished jobs are never noticed. ``squeue`` works there, as long
-  as finished jobs stay in it (``MinJobAge``); with ``MinJobAge`` below 120 s the plugin falls back to
+  as finished jobs stay in it (``MinJobAge``); with ``MinJobAge`` below 3 times the delay before its first
+  status check (``--slurm-init-seconds-before-status-checks``, 40 s by default) the plugin falls back to
   ``sacct`` whenever ``sacct`` is installed;
 - a job that asks for more CPUs or memory than any node of its partition has stays pending
   (``PD (PartitionConfig)``) on clusters that do not refuse it at submission.
@@ -25,9 +26,9 @@ __all__ = ["SlurmSetupError", "JobRequest", "STATUS_SWITCH", "check_slurm", "sta
 #: The command-line switch (and profile key ``slurm-status-command``) for clusters without accounting.
 STATUS_SWITCH = "--slurm-status-command squeue"
 
-#: The plugin falls back from ``squeue`` to ``sacct`` when ``MinJobAge`` is below this [s] (3 x its
-#: first status-check delay of 40 s).
-SQUEUE_MIN_JOB_AGE = 120
+#: The plugin falls back from ``squeue`` to ``sacct`` when ``MinJobAge`` is below this many times the delay
+#: before its first status check.
+SQUEUE_MIN_JOB_AGE_FACTOR = 3
 
 
 class SlurmSetupError(RuntimeError):
@@ -74,13 +75,15 @@ def _min_job_age():
     return int(found[1]) if found else None
 
 
-def status_command_problem(status_command):
+def status_command_problem(status_command, first_check_delay):
     """Return why the plugin's status command would not see jobs finish on this cluster, or None.
 
     Parameters
     ----------
     status_command : {"sacct", "squeue"}
         The plugin's setting ``slurm-status-command``.
+    first_check_delay : int
+        The plugin's setting ``slurm-init-seconds-before-status-checks`` [s].
 
     Returns
     -------
@@ -88,16 +91,18 @@ def status_command_problem(status_command):
         One line: what fails and the switch to use.
     """
     min_job_age = _min_job_age()
+    least_job_age = SQUEUE_MIN_JOB_AGE_FACTOR * first_check_delay
     used = status_command
-    if status_command == "squeue" and shutil.which("sacct") and (min_job_age or 0) < SQUEUE_MIN_JOB_AGE:
+    if status_command == "squeue" and shutil.which("sacct") and (min_job_age or 0) < least_job_age:
         used = "sacct"
     if used == "sacct":
         status, _, error = _run("sacct", "--noheader", "--allocations", "--starttime", "now")
         if status != 0:
             if status_command == "squeue":
                 return (f"the SLURM status command falls back to sacct because MinJobAge = {min_job_age} s is "
-                        f"below {SQUEUE_MIN_JOB_AGE} s, and sacct fails on this cluster ({error}): ask for a "
-                        f"MinJobAge of at least {SQUEUE_MIN_JOB_AGE} s in slurm.conf")
+                        f"below {least_job_age} s ({SQUEUE_MIN_JOB_AGE_FACTOR} x "
+                        f"--slurm-init-seconds-before-status-checks), and sacct fails on this cluster ({error}): "
+                        f"ask for a MinJobAge of at least {least_job_age} s in slurm.conf, or lower that option")
             return (f"the SLURM status command sacct fails on this cluster ({error}), so finished jobs would never "
                     f"be noticed: without an accounting database run with {STATUS_SWITCH}")
     return None
@@ -149,12 +154,14 @@ def request_problem(jobs):
     return None
 
 
-def check_slurm(status_command, jobs):
+def check_slurm(status_command, first_check_delay, jobs):
     """Check the status command and every job's request against the cluster.
 
     Parameters
     ----------
     status_command : {"sacct", "squeue"}
+    first_check_delay : int
+        ``slurm-init-seconds-before-status-checks`` [s].
     jobs : Iterable[JobRequest]
         The jobs about to be submitted.
 
@@ -163,6 +170,6 @@ def check_slurm(status_command, jobs):
     SlurmSetupError
         With one line saying what to change.
     """
-    problem = status_command_problem(status_command) or request_problem(jobs)
+    problem = status_command_problem(status_command, first_check_delay) or request_problem(jobs)
     if problem:
         raise SlurmSetupError(problem)

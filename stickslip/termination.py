@@ -11,7 +11,7 @@ files removed) exactly as after Ctrl-C. An interrupt that arrives while compiled
 import signal
 from contextlib import contextmanager
 
-__all__ = ["sigterm_as_interrupt", "Terminated", "interruption", "exit_status"]
+__all__ = ["sigterm_as_interrupt", "raise_interrupt_on_sigterm", "Terminated", "interruption", "exit_status"]
 
 
 class Terminated(KeyboardInterrupt):
@@ -40,10 +40,20 @@ def exit_status(interrupt):
     return 128 + getattr(interrupt, "signum", signal.SIGINT)
 
 
+def raise_interrupt_on_sigterm():
+    """From now on SIGTERM raises :class:`Terminated` (a ``KeyboardInterrupt``) in the main thread.
+
+    Returns
+    -------
+    The previous SIGTERM handler.
+    """
+    return signal.signal(signal.SIGTERM, _interrupt)
+
+
 @contextmanager
 def sigterm_as_interrupt():
     """Within the block, SIGTERM raises ``KeyboardInterrupt`` (main thread only); the old handler comes back after."""
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    previous = raise_interrupt_on_sigterm()
     try:
         yield
     finally:

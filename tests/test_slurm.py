@@ -2,8 +2,9 @@
 
 The ci study runs through the SLURM profile (every job through sbatch) on a cluster without an
 accounting database, and gives the same HDF5 files and database as a local run. With the wrong status
-command, or more CPUs per job than the node has, the workflow stops at start with a message instead of
-hanging. Every snakemake run is under a timeout: a hang fails the test.
+command, or more CPUs or memory per job than the node has, the workflow stops at start with a message
+instead of hanging. Ctrl-C or SIGTERM cancels the jobs a run has submitted. Every snakemake run is under a
+timeout: a hang fails the test.
 
 Needs root and Debian's SLURM packages (tests/slurm/packages.txt; `bash .ci/run` installs them); skipped
 with the reason otherwise (failed instead where STICKSLIP_REQUIRE_SLURM is set, as .ci/run does).
@@ -13,6 +14,7 @@ import os
 import signal
 import sqlite3
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -47,17 +49,35 @@ def cluster(tmp_path_factory):
     subprocess.run(["bash", str(CLUSTER), "stop", str(directory)], timeout=120, check=False)
 
 
-def run_snakemake(directory, env, *args, timeout):
-    """Run snakemake; on a timeout kill it with its whole process group and fail."""
-    process = subprocess.Popen(["snakemake", *args], cwd=directory, env=env, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True, start_new_session=True)
+def start_snakemake(directory, env, *args):
+    """Start snakemake in ``directory`` in its own process group; its output goes to ``directory``/snakemake.log."""
+    with open(directory / "snakemake.log", "w") as log:
+        return subprocess.Popen(["snakemake", *args], cwd=directory, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+
+
+def finish(process, directory, timeout):
+    """Wait for a snakemake of :func:`start_snakemake`; on a timeout kill its process group and fail.
+
+    Returns
+    -------
+    (int, str)
+        Exit status and output.
+    """
     try:
-        output, _ = process.communicate(timeout=timeout)
+        process.wait(timeout=timeout)
     except subprocess.TimeoutExpired:
         os.killpg(process.pid, signal.SIGKILL)
-        output, _ = process.communicate()
-        pytest.fail(f"snakemake {' '.join(args)} still running after {timeout} s (a hang):\n{output[-4000:]}")
-    return process.returncode, output
+        process.wait()
+        output = (directory / "snakemake.log").read_text()
+        pytest.fail(f"snakemake {' '.join(process.args[1:])} still running after {timeout} s (a hang):\n"
+                    f"{output[-4000:]}")
+    return process.returncode, (directory / "snakemake.log").read_text()
+
+
+def run_snakemake(directory, env, *args, timeout):
+    """Run snakemake under a timeout (see :func:`finish`)."""
+    return finish(start_snakemake(directory, env, *args), directory, timeout)
 
 
 def slurm_jobs(env):
@@ -65,6 +85,11 @@ def slurm_jobs(env):
     out = subprocess.run(["squeue", "--noheader", "--states=all", "--format", "%i %P %T"], env=env,
                          capture_output=True, text=True, timeout=60, check=True).stdout
     return {line.split()[0]: tuple(line.split()[1:]) for line in out.splitlines()}
+
+
+def new_jobs(env, before):
+    """Jobs of :func:`slurm_jobs` not in ``before``."""
+    return {job: state for job, state in slurm_jobs(env).items() if job not in before}
 
 
 def table(database, query):
@@ -78,7 +103,7 @@ def test_ci_study_through_slurm_equals_the_local_run(cluster, ci_study, tmp_path
     status, output = run_snakemake(remote, cluster, *SLURM, *CI, timeout=1200)
     assert status == 0, output[-4000:]
     study = Study(yaml.safe_load((REPO / "workflow" / "config" / "ci.yaml").read_text()), ["ci.yaml"])
-    submitted = {job: state for job, state in slurm_jobs(cluster).items() if job not in before}
+    submitted = new_jobs(cluster, before)
     # every job went through sbatch, into the partition named once in the environment, and completed
     assert len(submitted) == (len(study.meshes) + len(study.simulations) + len(study.analysis_jobs)
                               + len(study.figures) + 1)
@@ -109,3 +134,34 @@ def test_a_setup_that_would_hang_stops_at_start(cluster, tmp_path, args, message
     assert status != 0
     assert message in " ".join(output.split()), output[-4000:]
     assert slurm_jobs(cluster) == before  # nothing was submitted
+
+
+@pytest.fixture
+def partition_down(cluster):
+    """Partition 'stickslip' down during the test: jobs are accepted and stay pending, as on a full cluster."""
+    def set_state(state):
+        subprocess.run(["scontrol", "update", "PartitionName=stickslip", f"State={state}"], env=cluster,
+                       timeout=60, check=True)
+    set_state("DOWN")
+    yield
+    set_state("UP")
+
+
+@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_an_interrupted_run_cancels_its_submitted_jobs(cluster, partition_down, tmp_path, signal_number):
+    directory = copy_workflow(tmp_path)
+    before = slurm_jobs(cluster)
+    process = start_snakemake(directory, cluster, *SLURM, *CI)
+    pending, steady = {}, 0
+    for _ in range(300):  # until the first round of jobs is submitted: some jobs, none more for 5 s
+        submitted = new_jobs(cluster, before)
+        steady = steady + 1 if submitted and submitted == pending else 0
+        pending = submitted
+        if process.poll() is not None or steady == 5:
+            break
+        time.sleep(1)
+    assert pending and set(pending.values()) == {("stickslip", "PENDING")}, (directory / "snakemake.log").read_text()
+    os.killpg(process.pid, signal_number)  # a terminal's Ctrl-C reaches the whole foreground process group
+    status, output = finish(process, directory, timeout=120)
+    assert status != 0
+    assert set(new_jobs(cluster, before).values()) == {("stickslip", "CANCELLED")}, output[-4000:]

@@ -72,11 +72,17 @@ onstart:
     # A SLURM run checks, before submitting anything, that it would not hang (stickslip.cluster).
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
         from stickslip.cluster import JobRequest, SlurmSetupError, check_slurm
+        from stickslip.termination import raise_interrupt_on_sigterm
 
         requests = [JobRequest(job.rule.name, job.threads, job.resources.get("mem_mb"),
                                job.resources.get("slurm_partition") or None)
                     for job in workflow.dag.needrun_jobs() if not job.is_local]
         try:
-            check_slurm(workflow.executor_settings.status_command, requests)
+            settings = workflow.executor_settings
+            check_slurm(settings.status_command, settings.init_seconds_before_status_checks, requests)
         except SlurmSetupError as error:
             raise WorkflowError(f"SLURM: {error}") from None
+        # SIGTERM (kill, a wall time or scancel of the job Snakemake runs in) ends the run as Ctrl-C does: the
+        # submitted jobs are cancelled (scancel). Snakemake's own SIGTERM handler waits for them instead, for
+        # hours or, for a job that never starts, forever.
+        raise_interrupt_on_sigterm()
