@@ -5,7 +5,9 @@ state of one run with ``n_trace`` interfaces, stiff (a) and compliant (b) drivin
 microscopic events as black dots, single-slip stress drops in the colour of the slipping
 interface, multi-slip drops black. (c) rho(s), the fraction of slip events involving s
 interfaces, for every n: stiff dashed, compliant solid. (f) Density of the stress drop
-Delta mu_a [sig0] of the slipping interface in single-slip events, compliant driving, every n.
+Delta mu_a [sig0] of the slipping interface in single-slip events, compliant driving, every n,
+with Welch's test of equal means between the smallest and the largest n and the shift it
+would detect (:mod:`stickslip.events.shift_test`).
 Runs at the paper's Phi (5e-4 stiff, 5e-7 compliant) are pooled by (regime, n) over seeds; the
 panel texts give N, Phi and the number of events.
 """
@@ -16,6 +18,7 @@ import numpy as np
 
 from ..events.extraction import interfaces_in, slip_fractions
 from ..events.results import group_runs, pooled
+from ..events.shift_test import shift_test
 from ..params import param
 from ..registry import register
 from .numerical_common import REGIME_LINESTYLE, read_inputs, run_phi
@@ -120,6 +123,7 @@ def _rho_panel(ax, groups):
 
 
 def _drop_panel(ax, groups, bins):
+    samples = {}
     for (regime, n), files in groups.items():
         if regime != "compliant":
             continue
@@ -127,14 +131,22 @@ def _drop_panel(ax, groups, bins):
         if per.empty:
             continue
         dmu = per["dmu"].to_numpy()[per["single"].to_numpy(dtype=bool)]
+        samples[n] = dmu
         plot_density(ax, dmu, range_edges(dmu, bins), **{**n_style(n), "label": f"$n = {n}$ ({dmu.size})"})
     ax.set_xlabel(r"$\Delta\mu_a / \sigma_0$")
     ax.set_ylabel(r"$P(\Delta\mu_a)$")
     ax.set_title("compliant, single slips", fontsize=9)
     ax.legend(fontsize=7, frameon=False, title="(events)", title_fontsize=6)
+    if len(samples) >= 2:
+        low, high = min(samples), max(samples)
+        test = shift_test(samples[low], samples[high])
+        ax.text(0.98, 0.55, f"$n = {high}$ vs ${low}$: mean {100 * test['shift']:+.0f} %\n"
+                f"Welch $p = {test['p_value']:.2g}$\n"
+                f"detectable: {100 * test['detectable_shift']:.0f} %", transform=ax.transAxes,
+                ha="right", va="top", fontsize=6)
 
 
-@register("figure", NAME, "2", Fig2Params, inputs=("analysis:numerical-events",))
+@register("figure", NAME, "3", Fig2Params, inputs=("analysis:numerical-events",))
 def run(params, inputs, output):
     """Fig. 2: Sigma(gamma) stiff and compliant, rho(s) for every n, P(Delta mu_a) compliant."""
     files = read_inputs(inputs, "analysis:numerical-events", ("increments", "slips", "slip_interfaces"), NAME)
