@@ -259,14 +259,29 @@ def available(kind):
     return dict(sorted(_plugins[kind].items()))
 
 
-def get(kind, name):
+def get(kind, name, module=None):
     """Return one plugin by kind and name.
+
+    Parameters
+    ----------
+    kind : {"solver", "analysis", "figure"}
+    name : str
+    module : str, optional
+        The module that registers the plugin (its :attr:`Plugin.module`, which the
+        workflow passes to each job): imported alone, so that a job does not import
+        every plugin (and their libraries: matplotlib, scipy, ...). Without it, or if it
+        does not register ``name``, every plugin is loaded. Name clashes between plugins
+        are found by the full load, which the workflow makes before any job.
 
     Raises
     ------
     PluginError
         If there is none; the message lists the names that exist.
     """
+    if module is not None and kind in KINDS and name not in _plugins[kind]:
+        importlib.import_module(module)
+    if module is not None and name in _plugins.get(kind, {}) and _plugins[kind][name].module == module:
+        return _plugins[kind][name]
     plugins = available(kind)
     if name not in plugins:
         raise PluginError(f"unknown {kind} {name!r}; available: {', '.join(plugins) or '(none)'}")

@@ -472,6 +472,11 @@ class Study:
         return code_hash(registry.get(kind, registry.config_key(name)[0]).module)
 
     @staticmethod
+    def module(kind, name):
+        """Return the module that registers a plugin (jobs import only it, :func:`stickslip.registry.get`)."""
+        return registry.get(kind, registry.config_key(name)[0]).module
+
+    @staticmethod
     def caption(figure):
         """Return the caption of a figure: its plugin's summary, name and version."""
         plugin = registry.get("figure", registry.config_key(figure)[0])

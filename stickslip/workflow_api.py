@@ -117,8 +117,8 @@ def _plugin_recording(record, outputs, plugin, params, run_id, **extra):
                      params=params_to_dict(params), **extra)
 
 
-def _load(kind, name, params_json):
-    plugin = registry.get(kind, registry.config_key(name)[0])
+def _load(kind, name, params_json, module):
+    plugin = registry.get(kind, registry.config_key(name)[0], module)
     params = parse_params(plugin.params, json.loads(params_json), owner=f"{kind} '{name}'")
     return plugin, params
 
@@ -148,7 +148,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache=""):
             mesh.write_mesh(params, Path(output))
 
 
-def run_simulation(solver, params_json, output, record, log, *, inputs, threads, numba_cache=""):
+def run_simulation(solver, params_json, output, record, log, *, inputs, threads, numba_cache="", module=None):
     """Run one solver.
 
     Parameters
@@ -166,12 +166,14 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         Threads of the parallel kernels.
     numba_cache : {"", "job"}
         See :func:`prepare_environment`.
+    module : str, optional
+        The module that registers the plugin (see :func:`stickslip.registry.get`).
     """
     prepare_environment(threads, numba_cache)
     with _logged(log):
         from .numba_options import set_num_threads
 
-        plugin, params = _load("solver", solver, params_json)
+        plugin, params = _load("solver", solver, params_json, module)
         inputs = _artifacts(inputs)
         for role, path in inputs.items():
             _check_hdf5(role, path)
@@ -209,7 +211,7 @@ def partial_path(output):
     return output.parent / "partial" / output.name
 
 
-def run_analysis(analysis, params_json, simulation, output, record, log, *, numba_cache=""):
+def run_analysis(analysis, params_json, simulation, output, record, log, *, numba_cache="", module=None):
     """Run one analysis on one simulation output.
 
     Parameters
@@ -224,10 +226,12 @@ def run_analysis(analysis, params_json, simulation, output, record, log, *, numb
         Table file (HDF5), its provenance record, the log.
     numba_cache : {"", "job"}
         See :func:`prepare_environment`.
+    module : str, optional
+        The module that registers the plugin (see :func:`stickslip.registry.get`).
     """
     prepare_environment(1, numba_cache)
     with _logged(log):
-        plugin, params = _load("analysis", analysis, params_json)
+        plugin, params = _load("analysis", analysis, params_json, module)
         simulation = _artifacts(simulation)
         if simulation.format not in plugin.consumes:
             raise FileFormatError(f"{simulation}: a {simulation.format} file; analysis {analysis!r} reads "
@@ -241,7 +245,7 @@ def run_analysis(analysis, params_json, simulation, output, record, log, *, numb
             plugin.run(params, simulation, Path(output))
 
 
-def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_cache=""):
+def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_cache="", module=None):
     """Draw one figure.
 
     Parameters
@@ -257,10 +261,12 @@ def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_c
         The PDF (the PNG goes beside it), the provenance record, the log.
     numba_cache : {"", "job"}
         See :func:`prepare_environment`.
+    module : str, optional
+        The module that registers the plugin (see :func:`stickslip.registry.get`).
     """
     prepare_environment(1, numba_cache)
     with _logged(log):
-        plugin, params = _load("figure", figure, params_json)
+        plugin, params = _load("figure", figure, params_json, module)
         inputs = _artifacts(inputs_json)
         files = [(category, item) for category, items in sorted(inputs.items()) for item in items]
         parents = {item.parent.run_id: item.parent for _, item in files if item.parent is not None}

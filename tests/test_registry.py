@@ -1,6 +1,8 @@
 """Plugin registry: registration checks, lookup, run ids."""
 
 import dataclasses
+import subprocess
+import sys
 
 import pytest
 
@@ -79,3 +81,22 @@ def test_derived_run_ids_follow_the_lineage():
     assert a != registry.derived_run_id(plugin, params, ["0123456789abcdef"])
     assert a != registry.derived_run_id(plugin, parse_params(Params, {"x": 2}), ["0123456789abcdef",
                                                                                  "fedcba9876543210"])
+
+
+def _imports_after(statement):
+    """Which heavy modules a fresh interpreter has imported after ``statement``."""
+    probe = ("import sys\n" + statement + "\n"
+             "print(sorted(m for m in ('matplotlib', 'stickslip.solvers.fem', 'stickslip.figures.fig2') "
+             "if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return done.stdout.strip()
+
+
+def test_a_job_given_its_plugin_module_imports_only_that_module():
+    lever = "from stickslip import registry; p = registry.get('solver', 'lever', 'stickslip.solvers.lever')"
+    assert _imports_after(lever + "; assert p.module == 'stickslip.solvers.lever'") == "[]"
+    # without the module, or with one that does not register the name, every plugin is loaded
+    everything = "['matplotlib', 'stickslip.figures.fig2', 'stickslip.solvers.fem']"
+    assert _imports_after("from stickslip import registry; registry.get('solver', 'lever')") == everything
+    wrong = "from stickslip import registry; p = registry.get('solver', 'lever', 'stickslip.experiment.aging')"
+    assert _imports_after(wrong + "; assert p.name == 'lever'") == everything

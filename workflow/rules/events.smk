@@ -14,6 +14,7 @@ rule events:
         params=lambda wildcards: Study.dumps(STUDY.analyses[wildcards.analysis]),
         simulation=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).artifact()),
         code=lambda wildcards: Study.code("analysis", wildcards.analysis),
+        module=lambda wildcards: Study.module("analysis", wildcards.analysis),
     conda:
         CONDA_ENV
     script:

@@ -22,6 +22,7 @@ for _figure, _job in STUDY.figures.items():
             params=Study.dumps(_job.params),
             inputs=Study.dumps(_job.inputs),
             code=Study.code("figure", _figure),
+            module=Study.module("figure", _figure),
             caption=STUDY.caption(_figure),
         conda:
             CONDA_ENV

@@ -17,6 +17,7 @@ rule simulate:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
         inputs=lambda wildcards: Study.dumps(STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
         code=lambda wildcards: Study.code("solver", wildcards.solver),
+        module=lambda wildcards: Study.module("solver", wildcards.solver),
     conda:
         CONDA_ENV
     script:
