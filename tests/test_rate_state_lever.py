@@ -2,15 +2,17 @@
 the experimental analysis (which must recover its ground truth)."""
 
 import hashlib
+import re
 
 import numpy as np
 import pytest
 
-from stickslip import registry
+from stickslip import progress, registry
 from stickslip.experiment.analysis import analyse_record
 from stickslip.experiment.timeseries import read_timeseries, read_truth
 from stickslip.experiment.virtual import Apparatus
 from stickslip.experiment.virtual.rate_state import RateStateLaw
+from stickslip.experiment.virtual import slab_dynamics
 from stickslip.experiment.virtual.slab_dynamics import SlabDynamics
 from stickslip.params import parse_params
 
@@ -102,6 +104,42 @@ def test_lever_moment_balance_with_inertia():
     inertia = body_acceleration @ (np.arange(1, 4) * dynamics.masses)
     assert np.abs(y[:, 3:6]).max() > 1.0  # slips happened
     np.testing.assert_allclose(F * H, h * (N * mu.sum(axis=1) + inertia), rtol=1e-6, atol=1e-6 * (F * H).max())
+
+
+def _stack_n3(duration):
+    apparatus = Apparatus.from_protocol("stack", n=3, a=0, n_slabs=5, k_spring=55.0, normal_force=N, h=h, H=H,
+                                        V=0.01, gamma_start=-0.3)
+    dynamics = SlabDynamics(apparatus, LAW, 0.143, 5.0)
+    _, y0 = dynamics.initial_state(1e-6, 0.01, -0.3)
+    return dynamics.integrate(y0, duration, apparatus.shear_rate)
+
+
+def test_integration_in_pieces_takes_the_same_steps_as_in_one(monkeypatch):
+    """The pieces between two progress reports change nothing: 1, 7 and the default number of pieces
+    give the same step times, states and derivatives, bit for bit (stack n = 3 over 400 s, slips
+    included)."""
+    results = []
+    for pieces in (1, 7, slab_dynamics.PROGRESS_PIECES):
+        monkeypatch.setattr(slab_dynamics, "PROGRESS_PIECES", pieces)
+        results.append(_stack_n3(400.0))
+    assert np.abs(results[0][1][:, 3:6]).max() > 1.0  # slips happened
+    for t, y, dydt in results[1:]:
+        assert np.array_equal(t, results[0][0]) and np.array_equal(y, results[0][1])
+        assert np.array_equal(dydt, results[0][2])
+    assert np.all(np.diff(results[0][0]) > 0) and results[0][0][-1] == 400.0
+
+
+def test_integration_reports_simulated_time_rate_time_left_and_steps(monkeypatch, capsys):
+    """A job's log gets lines 'virtual experiment: <s done>/<s total> s simulated (<%>) [... elapsed,
+    ... left, <rate> s simulated/s, <steps> steps]', the last one at the full duration with the
+    number of accepted steps."""
+    monkeypatch.setenv(progress.INTERVAL_VARIABLE, "1e-9")
+    t, _, _ = _stack_n3(120.0)
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("virtual experiment:")]
+    done = [int(re.match(r"virtual experiment: (\d+)/120 s simulated", line)[1]) for line in lines]
+    assert len(lines) > 10 and done == sorted(done) and done[0] == 0 and done[-1] == 120
+    assert re.match(rf"virtual experiment: 120/120 s simulated \(100%\) \[[0-9:]+ elapsed, [0-9:]+ left, "
+                    rf"+[0-9.]+ s simulated/s, {t.size - 1} steps\]$", lines[-1])
 
 
 def _simulate(tmp_path, name, **values):

@@ -23,8 +23,7 @@ from scipy.interpolate import CubicHermiteSpline
 
 from .. import registry
 from ..experiment.timeseries import write_timeseries
-from ..experiment.virtual import record
-from ..experiment.virtual.model import apparatus as apparatus_of, per_interface
+from ..experiment.virtual.model import apparatus as apparatus_of, per_interface, random_streams, sensor_signals
 from ..experiment.virtual.rate_state import RateStateLaw
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS, SlabDynamics
 from ..experiment.virtual.slip_intervals import slip_intervals
@@ -92,8 +91,8 @@ RateStateLeverParams.__doc__ = ("Parameters of one rate-and-state virtual run: t
 def law_of(params):
     """The :class:`RateStateLaw` of a run: the per-interface values with the seed's quenched disorder
     (``b`` and ``D_c`` multiplied by ``exp(disorder xi - disorder^2 / 2)``, ``xi`` standard normal,
-    drawn from the first stream of ``SeedSequence(seed)``)."""
-    rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence(params.seed).spawn(2)[0]))
+    drawn from the disorder stream of :func:`~stickslip.experiment.virtual.model.random_streams`)."""
+    rng, _ = random_streams(params)
     spread = np.exp(params.disorder * rng.standard_normal((2, params.n_slabs)) - params.disorder ** 2 / 2)
     return RateStateLaw(a=per_interface(params, "rs_a"), b=per_interface(params, "rs_b") * spread[0],
                         D_c=per_interface(params, "D_c") * spread[1], mu0=per_interface(params, "mu0"), V0=params.V0)
@@ -108,14 +107,11 @@ def simulate(params):
 
     Returns
     -------
-    record : ExperimentRecord
-        The sensor signals.
-    truth : pandas.DataFrame
-        One row per interface per slip.
-    interfaces : pandas.DataFrame
-        One row per interface.
+    record, truth, interfaces
+        The sensor signals and the ground truth, as from the ``lever`` solver's
+        :func:`~stickslip.experiment.virtual.model.simulate` (the tables' columns: module docstring).
     steps : int
-        Integrator steps.
+        Accepted integrator steps.
     """
     apparatus = apparatus_of(params)
     law = law_of(params)
@@ -136,10 +132,7 @@ def simulate(params):
     theta = np.zeros((t.size, params.n_slabs))
     theta[:, index] = law.D_c[index] / law.V0 * np.exp(y[:, 2 * m:3 * m])
     truth = slip_intervals(apparatus, t, slips_at, V, theta, params.slip_velocity)
-    sensor_rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence(params.seed).spawn(2)[1]))
-    signals = record(apparatus, slips_at, params.duration, n=params.n, protocol=params.protocol, a=params.a,
-                     force_rate=params.force_rate, frame_rate=params.frame_rate, force_noise=params.force_noise,
-                     position_noise=params.position_noise, rng=sensor_rng)
+    signals = sensor_signals(params, apparatus, slips_at, random_streams(params)[1])
     slippable = np.zeros(params.n_slabs, bool)
     slippable[index] = True
     a = np.arange(1, params.n_slabs + 1)

@@ -13,7 +13,8 @@ from .friction import FrictionLaw
 from .history import integrate
 from .sensors import record, relative_positions
 
-__all__ = ["per_interface", "apparatus", "friction_law", "interfaces_table", "simulate"]
+__all__ = ["per_interface", "apparatus", "friction_law", "interfaces_table", "random_streams", "sensor_signals",
+           "simulate"]
 
 
 def per_interface(params, name):
@@ -59,6 +60,41 @@ def interfaces_table(lever, law, history):
                          "R_total": ends[1] - ends[0]})
 
 
+def random_streams(params):
+    """The two independent random streams of a run, derived from ``params.seed``: the interfaces'
+    disorder and the sensor noise (so changing a noise level leaves the slips unchanged).
+
+    Returns
+    -------
+    disorder, sensors : numpy.random.Generator
+        PCG64 generators of the first and second child of ``SeedSequence(seed)``.
+    """
+    return tuple(np.random.Generator(np.random.PCG64(child)) for child in np.random.SeedSequence(params.seed).spawn(2))
+
+
+def sensor_signals(params, lever, positions, rng):
+    """What the force sensor and the camera record during a run (:func:`.sensors.record`).
+
+    Parameters
+    ----------
+    params : LeverParams or RateStateLeverParams
+        Protocol (``n``, ``protocol``, ``a``), ``duration`` [s] and the sensor parameters
+        (``force_rate``, ``frame_rate`` [Hz], ``force_noise`` [N], ``position_noise`` [mm]).
+    lever : Apparatus
+    positions : callable
+        Slip of every interface at given times [s] -> [n_times, n_slabs] [mm].
+    rng : numpy.random.Generator
+        The sensor stream of :func:`random_streams`.
+
+    Returns
+    -------
+    ExperimentRecord
+    """
+    return record(lever, positions, params.duration, n=params.n, protocol=params.protocol, a=params.a,
+                  force_rate=params.force_rate, frame_rate=params.frame_rate, force_noise=params.force_noise,
+                  position_noise=params.position_noise, rng=rng)
+
+
 def simulate(params):
     """Run the virtual experiment.
 
@@ -74,18 +110,9 @@ def simulate(params):
         One row per interface per slip.
     interfaces : pandas.DataFrame
         One row per interface.
-
-    Notes
-    -----
-    Two independent random streams derive from ``seed``: the threshold disorder and the
-    sensor noise, so changing a noise level leaves the slips unchanged.
     """
-    disorder_seed, sensor_seed = np.random.SeedSequence(params.seed).spawn(2)
+    disorder, sensors = random_streams(params)
     lever, law = apparatus(params), friction_law(params)
-    history = integrate(lever, law, params.duration, params.slip_duration,
-                        np.random.Generator(np.random.PCG64(disorder_seed)))
-    signals = record(lever, lambda times: relative_positions(history, times), history.duration, n=params.n,
-                     protocol=params.protocol, a=params.a, force_rate=params.force_rate, frame_rate=params.frame_rate,
-                     force_noise=params.force_noise, position_noise=params.position_noise,
-                     rng=np.random.Generator(np.random.PCG64(sensor_seed)))
+    history = integrate(lever, law, params.duration, params.slip_duration, disorder)
+    signals = sensor_signals(params, lever, lambda times: relative_positions(history, times), sensors)
     return signals, history.slips, interfaces_table(lever, law, history)

@@ -27,19 +27,34 @@ __all__ = ["ros2"]
 GAMMA = 1.0 + 1.0 / np.sqrt(2.0)
 
 
-@njit
-def ros2(y0, t_end, args, rtol, atol):
-    """Integrate ``dy/dt = rhs(y, *args)`` (:func:`.slab_equations.rhs`) from t = 0 to ``t_end``.
+#: First trial step of an integration [s].
+FIRST_STEP = 1e-6
 
-    The right-hand side is called directly (not passed as an argument) so that numba caches the
-    compiled integrator on disk.
+
+@njit
+def ros2(y0, t0, h0, t_pause, t_end, args, rtol, atol):
+    """Integrate ``dy/dt = rhs(y, *args)`` (:func:`.slab_equations.rhs`) from ``t0`` towards ``t_end``,
+    returning after the first accepted step at or beyond ``t_pause``.
+
+    Only ``t_end`` cuts a step short; ``t_pause`` does not, so that integrating in pieces (each call
+    starting from the last state, time and next step size of the previous one) accepts exactly the
+    same steps, bit for bit, as one call from 0 to ``t_end`` (the caller reports progress between
+    the pieces, :meth:`.slab_dynamics.SlabDynamics.integrate`). The right-hand side is called
+    directly (not passed as an argument) so that numba caches the compiled integrator on disk.
 
     Parameters
     ----------
     y0 : numpy.ndarray
-        Initial state, float64 [n].
+        State at ``t0``, float64 [n].
+    t0 : float
+        Start time.
+    h0 : float
+        First trial step (> 0; :data:`FIRST_STEP` for a new integration, else the ``h`` returned
+        by the previous piece).
+    t_pause : float
+        Return once an accepted step reaches it (``t0 < t_pause <= t_end``).
     t_end : float
-        End time (> 0).
+        End time of the whole integration (no step goes beyond it).
     args : tuple
         Arguments of :func:`.slab_equations.rhs` after ``y``.
     rtol : float
@@ -49,13 +64,15 @@ def ros2(y0, t_end, args, rtol, atol):
     Returns
     -------
     t : numpy.ndarray
-        Accepted step times, float64 [n_steps + 1] (from 0 to ``t_end``).
+        ``t0`` and the accepted step times, float64 [n_steps + 1].
     y : numpy.ndarray
         States, float64 [n_steps + 1, n].
     dydt : numpy.ndarray
         ``rhs`` at those states, float64 [n_steps + 1, n].
     ok : bool
         False if the step size underflowed (the arrays end at the last accepted step).
+    h : float
+        Trial size of the next step.
     """
     n = y0.size
     capacity = 1024
@@ -64,14 +81,14 @@ def ros2(y0, t_end, args, rtol, atol):
     fs = np.empty((capacity, n))
     y = y0.copy()
     fy = rhs(y, *args)
-    t = 0.0
+    t = t0
     ts[0], ys[0], fs[0] = t, y, fy
     count = 1
-    h = min(1e-6, t_end)
+    h = min(h0, t_end - t0)
     identity = np.eye(n)
-    while t < t_end:
+    while t < t_pause:
         if h < 1e-14 * max(1.0, t):
-            return ts[:count], ys[:count], fs[:count], False
+            return ts[:count], ys[:count], fs[:count], False, h
         h = min(h, t_end - t)
         J = jacobian(y, *args)
         matrix = identity - GAMMA * h * J
@@ -98,4 +115,4 @@ def ros2(y0, t_end, args, rtol, atol):
         ts[count], ys[count], fs[count] = t, y, fy
         count += 1
         h *= factor
-    return ts[:count], ys[:count], fs[:count], True
+    return ts[:count], ys[:count], fs[:count], True, h

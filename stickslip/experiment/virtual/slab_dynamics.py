@@ -25,10 +25,12 @@ Units: lengths [mm], forces [N], masses [kg] (accelerations ``1000 F / M`` [mm/s
 """
 
 import dataclasses
+import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ... import progress
 from . import rosenbrock
 from .slab_equations import friction as _friction, jacobian as _jacobian, rhs as _rhs
 
@@ -40,6 +42,9 @@ METHODS = ("ROS2", "Radau", "BDF", "LSODA")
 DEFAULT_METHOD = "ROS2"
 #: mm/s^2 per N/kg.
 MM_PER_M = 1000.0
+#: The compiled integration runs in this many pieces of equal simulated time, with a progress
+#: report after each (the steps are the same as in one piece).
+PROGRESS_PIECES = 500
 
 
 @dataclasses.dataclass(frozen=True)
@@ -171,6 +176,13 @@ class SlabDynamics:
         atol : numpy.ndarray, optional
             Absolute tolerances [3 m + 1]; default :meth:`tolerances`.
 
+        Notes
+        -----
+        Progress (seconds simulated of ``duration``, rate, time left, steps so far) goes to stderr
+        through :mod:`stickslip.progress`: a live bar on a terminal, a line every interval in a job's
+        log. "ROS2" integrates in :data:`PROGRESS_PIECES` pieces for that, with the same steps (and
+        results, bit for bit) as in one piece.
+
         Returns
         -------
         t : numpy.ndarray
@@ -189,15 +201,66 @@ class SlabDynamics:
             raise ValueError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
         y0 = np.ascontiguousarray(y0, dtype=float)
         atol = self.tolerances() if atol is None else np.ascontiguousarray(atol, dtype=float)
-        if method == "ROS2":
-            t, y, dydt, ok = rosenbrock.ros2(y0, float(duration), (float(rate), *self._arrays()),
-                                             rtol, atol)
+        duration = float(duration)
+        with _SimulatedTime(duration) as clock:
+            if method == "ROS2":
+                return self._integrate_ros2(y0, duration, float(rate), rtol, atol, clock)
+
+            def rhs(t, y):
+                clock.at(t, None)
+                return self.rhs(y, rate)
+
+            solution = solve_ivp(rhs, (0.0, duration), y0, method=method, rtol=rtol, atol=atol,
+                                 jac=lambda t, y: self.jacobian(y, rate))
+            if not solution.success:
+                raise RuntimeError(
+                    f"rate-and-state integration failed at t = {solution.t[-1]:.6g} s: {solution.message}")
+            clock.at(duration, solution.t.size - 1)
+            y = solution.y.T
+            return solution.t, y, np.array([self.rhs(row, rate) for row in y])
+
+    def _integrate_ros2(self, y0, duration, rate, rtol, atol, clock):
+        """:func:`rosenbrock.ros2` in :data:`PROGRESS_PIECES` pieces of simulated time (the same steps as
+        in one piece), reporting to ``clock`` after each."""
+        args = (rate, *self._arrays())
+        t_now, y_now, h, steps = 0.0, y0, rosenbrock.FIRST_STEP, 0
+        ts, ys, fs = [], [], []
+        for k in range(1, PROGRESS_PIECES + 1):
+            t_pause = duration * k / PROGRESS_PIECES
+            if t_now >= t_pause:
+                continue
+            t, y, dydt, ok, h = rosenbrock.ros2(y_now, t_now, h, t_pause, duration, args, rtol, atol)
+            first = 1 if ts else 0          # a later piece starts where the previous one ended
+            ts.append(t[first:])
+            ys.append(y[first:])
+            fs.append(dydt[first:])
+            t_now, y_now, steps = t[-1], y[-1], steps + t.size - 1
+            clock.at(t_now, steps)
             if not ok:
-                raise RuntimeError(f"rate-and-state integration failed at t = {t[-1]:.6g} s: step size underflow")
-            return t, y, dydt
-        solution = solve_ivp(lambda t, y: self.rhs(y, rate), (0.0, duration), y0, method=method, rtol=rtol,
-                             atol=atol, jac=lambda t, y: self.jacobian(y, rate))
-        if not solution.success:
-            raise RuntimeError(f"rate-and-state integration failed at t = {solution.t[-1]:.6g} s: {solution.message}")
-        y = solution.y.T
-        return solution.t, y, np.array([self.rhs(row, rate) for row in y])
+                raise RuntimeError(f"rate-and-state integration failed at t = {t_now:.6g} s: step size underflow")
+        return np.concatenate(ts), np.concatenate(ys), np.concatenate(fs)
+
+
+class _SimulatedTime:
+    """Progress of an integration in whole seconds of simulated time, with the steps taken so far
+    (:func:`stickslip.progress.bar`: a live bar on a terminal, a line every interval in a log)."""
+
+    def __init__(self, duration):
+        self.bar = progress.bar(math.ceil(duration), desc="virtual experiment", unit="s simulated")
+        self.done = 0
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.bar.close()
+
+    def at(self, t, steps):
+        """Report that the integration reached time ``t`` [s] after ``steps`` accepted steps (None:
+        unknown, the scipy methods); returns None."""
+        if steps is not None:
+            self.bar.set_postfix_str(f"{steps} steps", refresh=False)
+        seconds = min(math.floor(t), self.bar.total)
+        if seconds > self.done:
+            self.bar.update(seconds - self.done)
+            self.done = seconds
