@@ -75,12 +75,12 @@ def test_cli_reports_bad_parameters_in_one_line(tmp_path, capsys):
 def test_a_full_run_takes_well_under_a_second():
     params = parse_params(LeverParams, {"n": 5, "seed": 3})
     simulate(params)
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: the wall time of the shared machine depends on the others' load
     record, truth, _ = simulate(params)
-    elapsed = time.perf_counter() - start
-    print(f"lever n=5, 6000 s: {elapsed:.3f} s, {len(truth)} slips")
+    elapsed = time.process_time() - start
+    print(f"lever n=5, 6000 s: {elapsed:.3f} CPU s, {len(truth)} slips")
     assert record.t_F[-1] == 6000.0 and len(truth) > 300
-    assert elapsed < 1.5  # measured ~0.3-0.5 s on the shared 2-core machine
+    assert elapsed < 1.5  # measured 0.31 CPU s (benchmarks/virtual_cost.py); wall time 1.4 s at load 14
     assert np.all(np.isfinite(record.F))
 
 
