@@ -72,13 +72,14 @@ def main(study):
         counts, _ = np.histogram(T, edges)
         print(f"  n={n}: {len(T):4d}  median {T.median():6.1f} +- {1.2533 * sem(T):4.1f}  {' '.join(map(str, counts))}")
 
-    print("\nP(dmu_1), stack: n, mean +- sem, std +- err, most populated 0.02 bin")
+    print("\nP(dmu_1), stack: n, mean +- sem, std +- err, most populated 0.02 bin, counts per 0.02 bin")
     dmu_edges = np.arange(0.0, 0.5001, 0.02)
     for n, part in stack[stack["a"] == 1].groupby("n"):
         counts, _ = np.histogram(part["dmu"], dmu_edges)
         mode = dmu_edges[np.argmax(counts)]
         print(f"  n={n}: mean {part['dmu'].mean():.3f} +- {sem(part['dmu']):.3f}  std {part['dmu'].std(ddof=1):.3f}"
-              f" +- {std_error(part['dmu']):.3f}  mode [{mode:.2f}, {mode + 0.02:.2f})")
+              f" +- {std_error(part['dmu']):.3f}  mode [{mode:.2f}, {mode + 0.02:.2f})  counts per 0.02 from 0.10: "
+              f"{' '.join(map(str, counts[5:18]))}")
 
     print("\naging fit dmu = c + B ln(T/1 s) on log bins, all stack slips with a T, and per n")
     valid = stack.dropna(subset=["T"])
