@@ -3,9 +3,10 @@
 Usage::
 
     python benchmarks/fem_relaxation_fidelity.py reference [--tol 1e-5]
-    python benchmarks/fem_relaxation_fidelity.py statistics --N 54 --plates 3 --k_drive 0.729 \\
-        --increments 4000 --dir runs/
-    python benchmarks/fem_relaxation_fidelity.py time-step --N 54 --plates 3 --k_drive 0.729 --dir runs/
+    python benchmarks/fem_relaxation_fidelity.py time-step --N 54 --plates 3 --phi 5e-4 \\
+        --increments 4000 --dir runs/ [--scales 1 2 4] [--relaxation exact]
+    python benchmarks/fem_relaxation_fidelity.py statistics --N 54 --plates 3 --phi 5e-4 \\
+        --increments 4000 --dir runs/ [--stored]
 
 ``reference`` (check a): the N = 9 reference case (FixedLever_historic), both relaxations
 from the same linear response (the dynamic one), increment by increment: where the
@@ -13,14 +14,17 @@ per-increment ``S_a1``, ``A_a1`` first differ, the largest relative difference o
 stress ``sigd`` after the kicks before that, and, after the first kick, how far the dynamic
 end state is from the exact equilibrium of its own wells (the dynamic tolerance's error).
 
-``time-step``: the same statistics from runs with ``dt_scale`` 1, 2 and 4 (default with
-``relaxation = exact``), each compared with ``dt_scale = 1``.
-
 ``statistics`` (check b): one run per relaxation (real run files in ``--dir``, resumed if
-present), then the steady-state slip events of each (:mod:`stickslip.events.extraction`):
-rho(s) compared by a chi-square test of the two count vectors, P(Delta mu_a) by the
-two-sample Kolmogorov-Smirnov and Anderson-Darling tests. Last line
-``slips=<dynamic>,<exact> rho_p=<chi2 p> dmu_ks_p=<KS p> dmu_ad_p=<AD p>``.
+present; the exact one is the ``time-step`` run with ``dt_scale`` 1), then the steady-state
+slip statistics of each (:mod:`stickslip.events.extraction`): rho(s), P(Delta mu_a) and the
+sizes ``S`` (well changes, all interfaces) of all steady-state events, compared by the tests
+of :mod:`stickslip.events.sample_comparison`, each with the difference it could detect. Last
+line ``slips=<dynamic>,<exact> rho_p=<chi2 p> dmu_ks_p=<KS p> dmu_ad_p=<AD p>
+size_ad_p=<AD p>``. ``--stored`` analyses the files as they are (a run still going, or
+stopped before ``--increments``, is read up to its last committed increment).
+
+``time-step``: the same statistics from runs with ``dt_scale`` 1, 2 and 4 (``--scales``;
+default with ``relaxation = exact``), each compared with the first.
 """
 
 import argparse
@@ -28,13 +32,14 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
 from stickslip import registry
 from stickslip.events.extraction import classify_increments, slip_events, slip_interfaces
+from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
 from stickslip.fem.observables import Observer
 from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
+from stickslip.fem.stiffness import stiffness_ratio
 from stickslip.fem.system import System
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
@@ -104,52 +109,67 @@ def _run(params, path):
     return time.perf_counter() - start
 
 
-def _slip_statistics(label, params, directory):
-    """Run (or resume) one simulation; its rho(s) counts and Delta mu_a values of the steady state."""
-    name = "_".join(f"{key}{value}" for key, value in params.items() if key not in ("max_increments",))
-    path = Path(directory) / f"{name}.h5"
-    seconds = _run(params, path)
+def _params(args, relaxation, dt_scale):
+    """Solver parameters of one run; the exact run with dt_scale 1 is shared by both checks."""
+    return {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed,
+            "max_increments": args.increments, "relaxation": relaxation, "dt_scale": dt_scale}
+
+
+def _slip_sample(label, params, args):
+    """Run (or resume) one simulation unless ``--stored``; the SlipSample of its steady state."""
+    name = "_".join(f"{key}{value}" for key, value in params.items() if key != "max_increments")
+    path = Path(args.dir) / f"{name}.h5"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    seconds = 0.0 if args.stored else _run(params, path)
     table = read_increments(path)
     N, n = params["N"], params["plates"] - 1
     classified = classify_increments(table, N)
     slips = slip_events(classified, N)
-    drops = slip_interfaces(classified, N)["dmu"].to_numpy()
     counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
-    steps = table["t"].iloc[-1] / read_run_attrs(path)["dt"] / max(int(table["kick"].iloc[1:].sum()), 1)
-    print(f"{label}: {len(table)} increments ({seconds:.0f} s this call), {len(slips)} steady-state slip events, "
-          f"counts by s = {counts.tolist()}, rho(s) = {np.round(counts / max(counts.sum(), 1), 3).tolist()}, "
-          f"Delta mu_a: {drops.size} values, mean {drops.mean():.4f} std {drops.std():.4f} (sig0), "
-          f"time steps per kick {steps:.0f}")
-    return counts, drops
+    drops = slip_interfaces(classified, N)["dmu"].to_numpy()
+    events = classified["kick"].to_numpy() & classified["steady"].to_numpy(dtype=bool)
+    sizes = classified.loc[events, [f"S_a{a}" for a in range(1, n + 1)]].sum(axis=1).to_numpy()
+    if not events.any():
+        raise SystemExit(f"{path}: no steady state in {len(table)} increments; run more (--increments)")
+    kicks = max(int(table["kick"].iloc[1:].sum()), 1)
+    steps = table["t"].iloc[-1] / read_run_attrs(path)["dt"] / kicks
+    print(f"{label}: {len(table)} increments ({seconds:.0f} s this call), steady state from increment "
+          f"{classified['increment'][classified['steady']].min()}, {events.sum()} steady-state events "
+          f"(size S: mean {sizes.mean():.1f}, median {np.median(sizes):.0f}, max {sizes.max()}), {len(slips)} "
+          f"slip events, counts by s = {counts.tolist()}, Delta mu_a: {drops.size} values, mean "
+          f"{drops.mean():.4f} std {drops.std():.4f} (sig0), time steps per kick {steps:.0f}")
+    return SlipSample(counts, drops, sizes)
 
 
 def _compare(first, second):
-    """Two-sample tests of rho(s) (chi-square on the counts) and P(Delta mu_a) (KS, Anderson-Darling)."""
-    (c1, d1), (c2, d2) = first, second
-    used = (c1 + c2) > 0
-    rho_p = stats.chi2_contingency(np.array([c1[used], c2[used]]))[1] if used.sum() > 1 else 1.0
-    ks = stats.ks_2samp(d1, d2)
-    ad = stats.anderson_ksamp([d1, d2], method=stats.PermutationMethod(n_resamples=2000, random_state=0))
-    print(f"rho(s): chi-square p = {rho_p:.3f}; P(Delta mu_a): KS statistic {ks.statistic:.3f} p = {ks.pvalue:.3f}, "
-          f"Anderson-Darling p = {ad.pvalue:.3f}")
-    return f"slips={len(d1)},{len(d2)} rho_p={rho_p:.3f} dmu_ks_p={ks.pvalue:.3f} dmu_ad_p={ad.pvalue:.3f}"
+    """Print the two-sample tests (:func:`stickslip.events.sample_comparison.compare_slip_samples`); summary line."""
+    r = compare_slip_samples(first, second)
+    d, z = r["dmu"], r["size"]
+    print(f"  rho(s): {np.round(r['rho_1'], 3).tolist()} against {np.round(r['rho_2'], 3).tolist()}, chi-square "
+          f"{r['rho_chi2']:.2f} p = {r['rho_p']:.3f}; rho(s>1) {r['multi_1']:.3f} against {r['multi_2']:.3f}, "
+          f"detectable difference {r['multi_resolution']:.3f}")
+    print(f"  P(Delta mu_a): {d['count_1']} against {d['count_2']} values, KS D = {d['ks']:.3f} p = {d['ks_p']:.3f} "
+          f"(D significant above {d['ks_resolution']:.3f}), Anderson-Darling p = {d['ad_p']:.3f}, mean shift "
+          f"{d['shift']:+.3f} p = {d['shift_p']:.3f} (detectable {d['detectable_shift']:.3f})")
+    print(f"  P(S) of all steady-state events: {z['count_1']} against {z['count_2']}, KS D = {z['ks']:.3f} "
+          f"p = {z['ks_p']:.3f} (D significant above {z['ks_resolution']:.3f}), Anderson-Darling p = {z['ad_p']:.3f}")
+    return (f"slips={d['count_1']},{d['count_2']} rho_p={r['rho_p']:.3f} dmu_ks_p={d['ks_p']:.3f} "
+            f"dmu_ad_p={d['ad_p']:.3f} size_ad_p={z['ad_p']:.3f}")
 
 
 def statistics(args):
-    base = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed,
-            "max_increments": args.increments}
-    dynamic = _slip_statistics("dynamic", {**base, "relaxation": "dynamic"}, args.dir)
-    exact = _slip_statistics("exact", {**base, "relaxation": "exact"}, args.dir)
-    print(_compare(dynamic, exact))
+    samples = {relaxation: _slip_sample(relaxation, _params(args, relaxation, 1.0), args)
+               for relaxation in ("exact", "dynamic")}
+    print("dynamic against exact:")
+    print(_compare(samples["dynamic"], samples["exact"]))
 
 
 def time_step(args):
-    base = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed,
-            "max_increments": args.increments, "relaxation": args.relaxation}
-    runs = {scale: _slip_statistics(f"dt_scale={scale:g}", {**base, "dt_scale": scale}, args.dir)
-            for scale in (1.0, 2.0, 4.0)}
-    for scale in (2.0, 4.0):
-        print(f"dt_scale={scale:g} against 1: {_compare(runs[1.0], runs[scale])}")
+    runs = {scale: _slip_sample(f"dt_scale={scale:g}", _params(args, args.relaxation, scale), args)
+            for scale in args.scales}
+    for scale in args.scales[1:]:
+        print(f"dt_scale={scale:g} against {args.scales[0]:g}:")
+        print(_compare(runs[args.scales[0]], runs[scale]))
 
 
 def main(argv=None):
@@ -163,11 +183,19 @@ def main(argv=None):
     for command in (stat, step):
         command.add_argument("--N", type=int, default=54)
         command.add_argument("--plates", type=int, default=3)
-        command.add_argument("--k_drive", type=float, required=True)
+        drive = command.add_mutually_exclusive_group(required=True)
+        drive.add_argument("--k_drive", type=float, help="drive stiffness per unit volume")
+        drive.add_argument("--phi", type=float, help="rigidity ratio Phi (5e-4 stiff, 5e-7 compliant); sets k_drive")
         command.add_argument("--seed", type=int, default=0)
         command.add_argument("--increments", type=int, default=4000)
         command.add_argument("--dir", default="fidelity-runs", help="directory of the run files (resumed if present)")
+        command.add_argument("--stored", action="store_true",
+                             help="analyse the run files as stored (also while running or stopped), run nothing")
+    step.add_argument("--scales", type=float, nargs="+", default=[1.0, 2.0, 4.0],
+                      help="dt_scale values; the first is the one the others are compared with")
     args = parser.parse_args(argv)
+    if getattr(args, "phi", None) is not None:
+        args.k_drive = float(f"{args.phi / stiffness_ratio(1.0, args.N):.6g}")
     {"reference": reference, "statistics": statistics, "time-step": time_step}[args.check](args)
 
 
