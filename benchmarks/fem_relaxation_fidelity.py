@@ -7,6 +7,7 @@ Usage::
         --increments 4000 --dir runs/ [--scales 1 2 4] [--relaxation exact]
     python benchmarks/fem_relaxation_fidelity.py statistics --N 54 --plates 3 --phi 5e-4 \\
         --increments 4000 --dir runs/ [--stored]
+    python benchmarks/fem_relaxation_fidelity.py stability --N 54 --plates 3 [--scales 1 2 4 8]
 
 ``reference`` (check a): the N = 9 reference case (FixedLever_historic), both relaxations
 from the same linear response (the dynamic one), increment by increment: where the
@@ -25,6 +26,13 @@ stopped before ``--increments``, is read up to its last committed increment).
 
 ``time-step``: the same statistics from runs with ``dt_scale`` 1, 2 and 4 (``--scales``;
 default with ``relaxation = exact``), each compared with the first.
+
+``stability``: the explicit stability limit of the time step, ``2 / omega_max`` with
+``omega_max^2`` the largest eigenvalue of ``M^-1 A`` (lumped mass ``M``, ``A`` the plates
+and the interfaces with the elastic law, their stiffest state; the drive is negligible),
+in units of the paper's dt; then, from the same kicked state, ``--steps`` time steps with
+each ``dt_scale`` of ``--scales`` and with 0.95 and 1.05 times the limit: stable, or the
+kinetic energy blows up (1e3 times the largest with the first scale).
 """
 
 import argparse
@@ -32,10 +40,13 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import eigsh
 
 from stickslip import registry
 from stickslip.events.extraction import classify_increments, slip_events, slip_interfaces
 from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
+from stickslip.fem.dynamics import time_step
 from stickslip.fem.observables import Observer
 from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
@@ -164,12 +175,51 @@ def statistics(args):
     print(_compare(samples["dynamic"], samples["exact"]))
 
 
-def time_step(args):
+def time_step_study(args):
     runs = {scale: _slip_sample(f"dt_scale={scale:g}", _params(args, args.relaxation, scale), args)
             for scale in args.scales}
     for scale in args.scales[1:]:
         print(f"dt_scale={scale:g} against {args.scales[0]:g}:")
         print(_compare(runs[args.scales[0]], runs[scale]))
+
+
+def _kinetic_energy(model, state):
+    free = model.mass_inv > 0
+    return 0.5 * float(np.sum(state.v[free] ** 2 / model.mass_inv[free]))
+
+
+def stability(args):
+    """The explicit stability limit of the time step: computed, then tried after a kick."""
+    mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
+    params = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "relaxation": "exact"}
+    system = System(FemParams(**params), mesh)
+    stiffness = system.equilibrium.matrix  # plates + interfaces with the elastic (stiffest) law, free DOFs
+    weight = sparse.diags(np.sqrt(system.model.mass_inv[system.equilibrium.free]))
+    omega = float(np.sqrt(eigsh(weight @ stiffness @ weight, k=1, which="LA", return_eigenvectors=False)[0]))
+    limit = 2.0 / omega / system.model.dt
+    print(f"omega_max = {omega:.4f} (lumped mass, elastic stiffness without the drive): velocity Verlet is "
+          f"stable (undamped) for dt < 2 / omega_max = {limit:.2f} dt")
+    system.compute_linear_response()
+    response = (system.delta_u, system.delta_eps, system.delta_target, system.delta_lever)
+    system.event_step(False)
+    system.event_step(True)
+    kicked = system.snapshot()
+    bound = np.inf  # 1e3 times the largest kinetic energy with the first dt_scale
+    for scale in (*args.scales, 0.95 * limit, 1.05 * limit):
+        trial = System(FemParams(**params, dt_scale=scale), mesh)
+        trial.set_linear_response(*response)
+        trial.restore(*kicked)
+        energy = np.empty(args.steps)
+        for i in range(args.steps):
+            time_step(trial.model, trial.state, trial._fe)
+            energy[i] = _kinetic_energy(trial.model, trial.state)
+            if not energy[i] < bound:
+                break
+        stable = i + 1 == args.steps
+        print(f"dt_scale={scale:.2f}: {i + 1} time steps ({(i + 1) * scale:.0f} dt), kinetic energy max "
+              f"{energy[: i + 1].max():.3e}, last {energy[i]:.3e}: "
+              f"{'stable' if stable else 'BLOWS UP (1e3 times the largest kinetic energy with dt_scale 1)'}")
+        bound = min(bound, 1e3 * energy.max()) if stable else bound
 
 
 def main(argv=None):
@@ -193,10 +243,16 @@ def main(argv=None):
                              help="analyse the run files as stored (also while running or stopped), run nothing")
     step.add_argument("--scales", type=float, nargs="+", default=[1.0, 2.0, 4.0],
                       help="dt_scale values; the first is the one the others are compared with")
+    stable = sub.add_parser("stability", help="explicit stability limit of the time step, computed and tried")
+    stable.add_argument("--N", type=int, default=54)
+    stable.add_argument("--plates", type=int, default=3)
+    stable.add_argument("--phi", type=float, default=5e-4, help="rigidity ratio Phi; sets k_drive")
+    stable.add_argument("--steps", type=int, default=4000, help="time steps after the kick per dt_scale")
+    stable.add_argument("--scales", type=float, nargs="+", default=[1.0, 2.0, 4.0, 8.0])
     args = parser.parse_args(argv)
     if getattr(args, "phi", None) is not None:
         args.k_drive = float(f"{args.phi / stiffness_ratio(1.0, args.N):.6g}")
-    {"reference": reference, "statistics": statistics, "time-step": time_step}[args.check](args)
+    {"reference": reference, "statistics": statistics, "time-step": time_step_study, "stability": stability}[args.check](args)
 
 
 if __name__ == "__main__":
