@@ -22,7 +22,9 @@ sizes ``S`` (well changes, all interfaces) of all steady-state events, compared 
 of :mod:`stickslip.events.sample_comparison`, each with the difference it could detect. Last
 line ``slips=<dynamic>,<exact> rho_p=<chi2 p> dmu_ks_p=<KS p> dmu_ad_p=<AD p>
 size_ad_p=<AD p>``. ``--stored`` analyses the files as they are (a run still going, or
-stopped before ``--increments``, is read up to its last committed increment).
+stopped before ``--increments``, is read up to its last committed increment). ``--start K``
+takes the statistics from increment K on instead of the extraction's steady state (which
+needs a slip, ``A_a = N``, of every interface: rare for some interfaces at N = 54).
 
 ``time-step``: the same statistics from runs with ``dt_scale`` 1, 2 and 4 (``--scales``;
 default with ``relaxation = exact``), each compared with the first.
@@ -40,7 +42,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy import sparse
+from scipy import sparse, stats
 from scipy.sparse.linalg import eigsh
 
 from stickslip import registry
@@ -48,10 +50,11 @@ from stickslip.events.extraction import classify_increments, slip_events, slip_i
 from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
 from stickslip.fem.dynamics import time_step
 from stickslip.fem.observables import Observer
-from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.fem.output import RunFile, read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.stiffness import stiffness_ratio
 from stickslip.fem.system import System
+from stickslip.h5io import open_file
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
 
@@ -126,15 +129,22 @@ def _params(args, relaxation, dt_scale):
             "max_increments": args.increments, "relaxation": relaxation, "dt_scale": dt_scale}
 
 
+def _run_path(params, directory):
+    name = "_".join(f"{key}{value}" for key, value in params.items() if key != "max_increments")
+    path = Path(directory) / f"{name}.h5"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
 def _slip_sample(label, params, args):
     """Run (or resume) one simulation unless ``--stored``; the SlipSample of its steady state."""
-    name = "_".join(f"{key}{value}" for key, value in params.items() if key != "max_increments")
-    path = Path(args.dir) / f"{name}.h5"
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path = _run_path(params, args.dir)
     seconds = 0.0 if args.stored else _run(params, path)
     table = read_increments(path)
     N, n = params["N"], params["plates"] - 1
     classified = classify_increments(table, N)
+    if args.start is not None:  # instead of the extraction's steady state (needs every interface to slip once)
+        classified["steady"] = classified["increment"].to_numpy() >= args.start
     slips = slip_events(classified, N)
     counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
     drops = slip_interfaces(classified, N)["dmu"].to_numpy()
@@ -181,6 +191,58 @@ def time_step_study(args):
     for scale in args.scales[1:]:
         print(f"dt_scale={scale:g} against {args.scales[0]:g}:")
         print(_compare(runs[args.scales[0]], runs[scale]))
+
+
+def _kick_outcomes(params, mesh, response, states):
+    """Kick and minimise every stored state with ``params``; per state (S, global well indices, sigd)."""
+    system = System(FemParams(**params), mesh)
+    system.set_linear_response(*response)
+    observer = Observer(system)
+    out = []
+    for state in states:
+        system.restore(*state)
+        previous = observer.well_index()
+        if not system.kick(system.params.margin)[0]:
+            raise SystemExit("a kick reached the margin")
+        row = observer.observe(previous)
+        size = sum(value for key, value in row.items() if key.startswith("S_a"))
+        out.append((size, system.well_index(), row["sigd"]))
+    return out
+
+
+def paired(args):
+    """The same stored states (before a kick) kicked with each variant; outcomes against the first variant."""
+    path = _run_path(_params(args, "exact", 1.0), args.dir)
+    with open_file(path) as file:
+        run = RunFile(file)
+        kick = file["increments"]["kick"][: run.nstored]
+        before = [i for i in range(args.start or 2, run.nstored - 1) if not kick[i]]
+        chosen = before[:: max(len(before) // args.kicks, 1)][: args.kicks]
+        states = [run.state(i) for i in chosen]
+        response, mesh = run.linear_response(), run.mesh
+    base = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "seed": args.seed}
+    outcomes = {}
+    for variant in args.variants:
+        relaxation, quiet, scale = variant.split(":")
+        start = time.perf_counter()
+        outcomes[variant] = _kick_outcomes({**base, "relaxation": relaxation, "quiet_steps": int(quiet),
+                                            "dt_scale": float(scale)}, mesh, response, states)
+        print(f"{variant}: {len(states)} kicks from the stored states {chosen[0]} ... {chosen[-1]} of {path.name}, "
+              f"{time.perf_counter() - start:.0f} s")
+    reference = outcomes[args.variants[0]]
+    ref_size = np.array([o[0] for o in reference])
+    for variant in args.variants[1:]:
+        size = np.array([o[0] for o in outcomes[variant]])
+        same = np.array([np.array_equal(a[1], b[1]) for a, b in zip(reference, outcomes[variant])])
+        stress = np.array([abs(a[2] - b[2]) / abs(a[2]) for a, b in zip(reference, outcomes[variant])])
+        diff = size - ref_size
+        sign_p = stats.wilcoxon(diff).pvalue if np.any(diff) else 1.0
+        print(f"{variant} against {args.variants[0]}: same wells after the event in {same.sum()} of {same.size}; "
+              f"event size S equal in {np.sum(diff == 0)}, larger in {np.sum(diff > 0)}, smaller in "
+              f"{np.sum(diff < 0)} (Wilcoxon signed-rank p = {sign_p:.3g}); mean S {size.mean():.1f} against "
+              f"{ref_size.mean():.1f}; stress after the event: relative difference median "
+              f"{np.median(stress):.1e}, max {stress.max():.1e}; where the wells agree: max "
+              f"{stress[same].max() if same.any() else float('nan'):.1e}")
 
 
 def _kinetic_energy(model, state):
@@ -230,7 +292,11 @@ def main(argv=None):
     stat = sub.add_parser("statistics", help="check b: slip statistics of one run per relaxation")
     step = sub.add_parser("time-step", help="slip statistics with dt, 2 dt and 4 dt")
     step.add_argument("--relaxation", default="exact", choices=("dynamic", "exact"))
-    for command in (stat, step):
+    pair = sub.add_parser("paired", help="stored states kicked with each variant (relaxation:quiet_steps:dt_scale)")
+    pair.add_argument("--variants", nargs="+", default=["dynamic:200:1", "exact:200:1"],
+                      help="relaxation:quiet_steps:dt_scale, the first is the reference")
+    pair.add_argument("--kicks", type=int, default=50, help="stored states to kick (evenly spread)")
+    for command in (stat, step, pair):
         command.add_argument("--N", type=int, default=54)
         command.add_argument("--plates", type=int, default=3)
         drive = command.add_mutually_exclusive_group(required=True)
@@ -239,6 +305,8 @@ def main(argv=None):
         command.add_argument("--seed", type=int, default=0)
         command.add_argument("--increments", type=int, default=4000)
         command.add_argument("--dir", default="fidelity-runs", help="directory of the run files (resumed if present)")
+        command.add_argument("--start", type=int, help="statistics from this increment on (default: the steady "
+                             "state of stickslip.events.extraction)")
         command.add_argument("--stored", action="store_true",
                              help="analyse the run files as stored (also while running or stopped), run nothing")
     step.add_argument("--scales", type=float, nargs="+", default=[1.0, 2.0, 4.0],
@@ -252,7 +320,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if getattr(args, "phi", None) is not None:
         args.k_drive = float(f"{args.phi / stiffness_ratio(1.0, args.N):.6g}")
-    {"reference": reference, "statistics": statistics, "time-step": time_step_study, "stability": stability}[args.check](args)
+    {"reference": reference, "statistics": statistics, "time-step": time_step_study, "stability": stability,
+     "paired": paired}[args.check](args)
 
 
 if __name__ == "__main__":
