@@ -52,8 +52,8 @@ class FemParams:
     eps_offset: float = param(1e-6, "minimal well width", minimum=0.0)
     weibull_k: float = param(2.0, "Weibull shape parameter of the well widths", exclusive_minimum=0.0)
     deps: float = param(1e-4, "kick size in equivalent strain", unit="eps0", exclusive_minimum=0.0)
-    dt_scale: float = param(1.0, "time step in units of the paper's dt = h / (2 pi c) / 10 (time-step studies; "
-                                 "1 = the paper's protocol)", exclusive_minimum=0.0, maximum=8.0)
+    dt_scale: float = param(1.0, "time step in units of the paper's dt = h / (2 pi c) / 10 (1 = the paper's "
+                                 "protocol; 2-4 keep the event statistics, not each event: docs/fem.md)", exclusive_minimum=0.0, maximum=8.0)
     tol: float = param(1e-5, "minimisation: relative residual tolerance", exclusive_minimum=0.0, maximum=0.5)
     niter_tol: int = param(20, "minimisation: consecutive steps below tol (and non-increasing)", minimum=1)
     max_iter: int = param(10_000_000, "minimisation: maximum time steps (then the run fails)", minimum=1)
