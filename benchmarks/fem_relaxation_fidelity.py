@@ -7,6 +7,8 @@ Usage::
         --increments 4000 --dir runs/ [--scales 1 2 4] [--relaxation exact]
     python benchmarks/fem_relaxation_fidelity.py statistics --N 54 --plates 3 --phi 5e-4 \\
         --increments 4000 --dir runs/ [--stored]
+    python benchmarks/fem_relaxation_fidelity.py paired --N 54 --plates 3 --phi 5e-4 --increments 4000 \\
+        --dir runs/ --start 100 --kicks 40 --variants dynamic:200:1 exact:200:1 exact:1000:1
     python benchmarks/fem_relaxation_fidelity.py stability --N 54 --plates 3 [--scales 1 2 4 8]
 
 ``reference`` (check a): the N = 9 reference case (FixedLever_historic), both relaxations
@@ -28,6 +30,14 @@ needs a slip, ``A_a = N``, of every interface: rare for some interfaces at N = 5
 
 ``time-step``: the same statistics from runs with ``dt_scale`` 1, 2 and 4 (``--scales``;
 default with ``relaxation = exact``), each compared with the first.
+
+``paired``: ``--kicks`` stored states before a kick (evenly spread from ``--start`` over the
+exact ``dt_scale`` 1 run, which must exist), each kicked and minimised with every variant
+``relaxation:quiet_steps:dt_scale``; against the first variant: in how many events every Gauss
+point ends in the same well, whether the event size ``S`` is equal, larger or smaller (Wilcoxon
+signed-rank test of the differences: a systematic sign), the mean ``S``, and the relative
+difference of the stress after the event. Pairs need no slip statistics: tens of events show a
+systematic difference that run-against-run tests would need thousands of events for.
 
 ``stability``: the explicit stability limit of the time step, ``2 / omega_max`` with
 ``omega_max^2`` the largest eigenvalue of ``M^-1 A`` (lumped mass ``M``, ``A`` the plates
