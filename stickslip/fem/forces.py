@@ -21,9 +21,9 @@ from numba import prange
 from ..numba_options import njit
 from .materials import cusp_stress, equivalent_strain, well_index
 from .quad4 import element_strain
-from .structured import apply_stencils
+from .structured import apply_groups, gather_views, plate_product
 
-__all__ = ["compute_force", "compute_force_in_wells", "wells_hold", "layer_ubar"]
+__all__ = ["plates", "compute_force", "compute_force_in_wells", "wells_hold", "layer_ubar"]
 
 
 @njit
@@ -86,12 +86,41 @@ def _interface_elements_parallel(nblock, iface_dofs, dNdx, iface_dV, epsy, K, G,
 
 
 @njit(parallel=True)
-def _plates_stencils_parallel(nblock, blocks, index, coef, u, f):
-    n = f.size
+def _plate_product_parallel(nblock, views, groups, triplet_ptr, triplet_view, triplet_coef, empty, work, u, f):
+    nview = views.shape[0]
     for b in prange(nblock):
-        f[b * n // nblock:(b + 1) * n // nblock] = 0.0
+        gather_views(views, b * nview // nblock, (b + 1) * nview // nblock, u, work[0], work[1])
+    ngroup = groups.shape[0]
     for b in prange(nblock):
-        apply_stencils(index, coef, blocks[b], blocks[b + 1], u, f)
+        apply_groups(groups, triplet_ptr, triplet_view, triplet_coef, b * ngroup // nblock, (b + 1) * ngroup // nblock,
+                     work[0], work[1], work[2], work[3], f)
+    for i in empty:
+        f[i] = 0.0
+
+
+@njit
+def plates(model, u, f):
+    """``f = K u``: the plates' elastic force, by the structured kernel or the assembled CSR product.
+
+    Parameters
+    ----------
+    model : Model
+    u : numpy.ndarray
+        [ndof] displacement [length].
+    f : numpy.ndarray
+        [ndof] force, overwritten.
+    """
+    m = model
+    if m.structured and m.nblock > 1:
+        _plate_product_parallel(m.nblock, m.plate_views, m.plate_groups, m.plate_triplet_ptr, m.plate_triplet_view,
+                                m.plate_triplet_coef, m.plate_empty, m.plate_work, u, f)
+    elif m.structured:
+        plate_product(m.plate_views, m.plate_groups, m.plate_triplet_ptr, m.plate_triplet_view, m.plate_triplet_coef,
+                      m.plate_empty, m.plate_work, u, f)
+    elif m.nblock > 1:
+        _plates_rows_parallel(m.nblock, m.k_ptr, m.k_col, m.k_val, u, f)
+    else:
+        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, u, f)
 
 
 @njit
@@ -128,15 +157,7 @@ def _drive(model, state):
 @njit
 def _force(model, state, fe, update_wells):
     m = model
-    if m.structured and m.nblock > 1:
-        _plates_stencils_parallel(m.nblock, m.stencil_blocks, m.stencil_index, m.stencil_coef, state.u, state.f)
-    elif m.structured:
-        state.f[:] = 0.0
-        apply_stencils(m.stencil_index, m.stencil_coef, 0, m.stencil_index.shape[0], state.u, state.f)
-    elif m.nblock > 1:
-        _plates_rows_parallel(m.nblock, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
-    else:
-        _plates_rows(0, m.ndof, m.k_ptr, m.k_col, m.k_val, state.u, state.f)
+    plates(m, state.u, state.f)
     if m.nblock > 1:
         _interface_elements_parallel(m.nblock, m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G, state.u,
                                      state.idx, state.eps, state.sig, fe, update_wells)

@@ -13,7 +13,7 @@ import numpy as np
 from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, layer_average_weights,
                        lumped_diagonal)
 from .quad4 import element_coordinates, shape_gradients
-from .structured import build_stencils, line_blocks
+from .structured import build_stencils, plan_product
 
 __all__ = ["Model", "State", "PLATE_KERNELS", "build_model", "new_state"]
 
@@ -22,9 +22,13 @@ Model = namedtuple("Model", [
     "dt",             # float: time step [time]
     "k_ptr", "k_col", "k_val",  # CSR [ndof, ndof] elastic stiffness of the plates [stress] (k_col int32)
     "structured",     # bool: plates by the stencils below (else by the CSR product, the reference)
-    "stencil_index",  # int64 [nentry, 8]: stencil entries of the plates (:mod:`.structured`)
-    "stencil_coef",   # float64 [nentry, 4]
-    "stencil_blocks", # int64 [nblock + 1]: entry ranges of the parallel blocks (whole node lines)
+    "plate_views",    # int64 [nview, 4]: the structured product's plan (:class:`.structured.PlatePlan`)
+    "plate_groups",   # int64 [ngroup, 5]
+    "plate_triplet_ptr",   # int64 [ngroup + 1]
+    "plate_triplet_view",  # int64 [ntriplet, 3]
+    "plate_triplet_coef",  # float64 [ntriplet, 12]
+    "plate_empty",    # int64 [nempty]: DOFs with an empty plate row
+    "plate_work",     # float64 [4, nwork]: scratch of the structured product (views x, y; rows x, y)
     "mass_inv",       # float64 [ndof]: 1 / lumped mass on free DOFs, 0 on prescribed DOFs
     "damping",        # float64 [ndof]: lumped background damping [mass / time]
     "prescribed",     # bool [ndof]
@@ -114,7 +118,7 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     k_col = k_col.astype(np.int32)  # less memory traffic in the sparse product
     if plate_kernel not in PLATE_KERNELS:
         raise ValueError(f"plate_kernel {plate_kernel!r}: expected one of {PLATE_KERNELS}")
-    stencils = build_stencils(mesh, k_ptr, k_col, k_val)
+    plan = plan_product(build_stencils(mesh, k_ptr, k_col, k_val), ndof)
     nblock = 4 * int(threads) if threads > 1 else 1
     nelem = conn.shape[0]
     mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
@@ -134,7 +138,9 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
     return Model(
         ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, structured=plate_kernel == "structured",
-        stencil_index=stencils.index, stencil_coef=stencils.coef, stencil_blocks=line_blocks(stencils.index, nblock),
+        plate_views=plan.views, plate_groups=plan.groups, plate_triplet_ptr=plan.triplet_ptr,
+        plate_triplet_view=plan.triplet_view, plate_triplet_coef=plan.triplet_coef, plate_empty=plan.empty_dofs,
+        plate_work=np.zeros((4, max(plan.view_size, plan.output_size))),
         mass_inv=mass_inv, damping=damping,
         prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
         iface_dV=dV[iface], epsy=np.ascontiguousarray(epsy, dtype=np.float64), K=float(K), G=float(G),

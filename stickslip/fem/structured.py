@@ -134,82 +134,205 @@ def build_stencils(mesh, ptr, col, val):
                          np.concatenate(coef) if coef else np.zeros((0, 4)))
 
 
-def line_blocks(index, nblock):
-    """Split the stencil entries into ``nblock`` ranges of whole node lines (for parallel kernels).
+class PlatePlan:
+    """The stencil entries arranged for the product kernel :func:`plate_product`.
+
+    The entries of one node line and class ``c`` (a *group*: the rows of the nodes ``b p + c``,
+    ``b = 0 .. nb - 1``) are gathered by target line and target class into *triplets*: the
+    2 x 2 blocks of block offsets ``db = -1, 0, +1`` (absent ones zero). A triplet reads a
+    *view* of its target line: the line's x and y displacements copied class by class into
+    contiguous arrays with one periodic ghost block on each side, so that every pass over
+    ``b`` is a contiguous loop with loop-invariant coefficients and no index array.
+
+    Attributes
+    ----------
+    views : numpy.ndarray
+        int64 [nview, 4]: target line start DOF, nodes per block ``q``, blocks ``nb``, offset
+        of the view in the view arrays (class ``c`` at ``offset + c (nb + 2)``, ghosts first and last).
+    groups : numpy.ndarray
+        int64 [ngroup, 5]: line start DOF, ``p``, class ``c``, ``nb``, offset of the group's
+        output in the output arrays.
+    triplet_ptr : numpy.ndarray
+        int64 [ngroup + 1]: the triplets of group ``g`` are ``triplet_ptr[g]:triplet_ptr[g + 1]``.
+    triplet_view : numpy.ndarray
+        int64 [ntriplet]: offset of the target class in the view arrays (its left ghost).
+    triplet_coef : numpy.ndarray
+        float64 [ntriplet, 12]: blocks ``(xx, xy, yx, yy)`` of ``db = -1, 0, +1`` [stress].
+    empty_dofs : numpy.ndarray
+        int64 [nempty]: DOFs whose row is empty (set to zero by the product).
+    view_size, output_size : int
+        Lengths of the work arrays (x and y each).
+    """
+
+    def __init__(self, views, groups, triplet_ptr, triplet_view, triplet_coef, empty_dofs, view_size, output_size):
+        self.views = views
+        self.groups = groups
+        self.triplet_ptr = triplet_ptr
+        self.triplet_view = triplet_view
+        self.triplet_coef = triplet_coef
+        self.empty_dofs = empty_dofs
+        self.view_size = view_size
+        self.output_size = output_size
+
+
+def plan_product(stencils, ndof):
+    """Arrange stencil entries into groups, triplets and views (:class:`PlatePlan`).
 
     Parameters
     ----------
-    index : numpy.ndarray
-        int64 [nentry, 8] (:class:`PlateStencils`), entries grouped by line.
-    nblock : int
+    stencils : PlateStencils
+    ndof : int
+        Number of DOFs.
 
     Returns
     -------
-    numpy.ndarray
-        int64 [nblock + 1]: entry boundaries; entries of one line stay in one range, so the
-        ranges write to disjoint DOFs.
+    PlatePlan
+
+    Raises
+    ------
+    ValueError
+        If an entry couples blocks more than one block apart (not a nearest-neighbour stencil).
     """
-    nentry = index.shape[0]
-    starts = np.r_[np.flatnonzero(np.diff(index[:, _START]) != 0) + 1, nentry]  # first entry of each next line
-    bounds = [0] + [int(starts[np.searchsorted(starts, b * nentry // nblock)]) for b in range(1, nblock)] + [nentry]
-    return np.asarray(bounds, dtype=np.int64)
-
-
-@njit(inline="always")
-def _pass(lo, hi, start, p, c, tstart, tp, tc, shift, a, b, cc, d, u, f):
-    for blk in range(lo, hi):
-        k = start + 2 * (blk * p + c)
-        j = tstart + 2 * ((blk + shift) * tp + tc)
-        ux = u[j]
-        uy = u[j + 1]
-        f[k] += a * ux + b * uy
-        f[k + 1] += cc * ux + d * uy
+    index, coef = stencils.index, stencils.coef
+    if index.size and np.abs(index[:, _DB]).max() > 1:
+        raise ValueError("a stencil entry couples blocks more than one block apart")
+    view_keys = sorted({(int(e[_TSTART]), int(e[_TP]), int(e[_NB])) for e in index})
+    view_offset, offset = {}, 0
+    for start, q, nb in view_keys:
+        view_offset[start, q] = offset
+        offset += q * (nb + 2)
+    views = np.array([[start, q, nb, view_offset[start, q]] for start, q, nb in view_keys],
+                     dtype=np.int64).reshape(-1, 4)
+    groups, ptr, triplet_view, triplet_coef = [], [0], [], []
+    covered = np.zeros(ndof, dtype=bool)
+    output = 0
+    group_keys = sorted({(int(e[_START]), int(e[_CLASS])) for e in index})
+    for start, c in group_keys:
+        mine = np.flatnonzero((index[:, _START] == start) & (index[:, _CLASS] == c))
+        p, nb = int(index[mine[0], _P]), int(index[mine[0], _NB])
+        groups.append([start, p, c, nb, output])
+        output += nb
+        covered[start + 2 * (np.arange(nb) * p + c)] = True
+        covered[start + 2 * (np.arange(nb) * p + c) + 1] = True
+        # entries in view order, three per pass (the last one padded with zero blocks)
+        position = sorted((view_offset[int(index[e, _TSTART]), int(index[e, _TP])]
+                           + int(index[e, _TCLASS]) * (nb + 2) + 1 + int(index[e, _DB]), e) for e in mine)
+        for first in range(0, len(position), 3):
+            chunk = position[first:first + 3]
+            chunk += [(chunk[0][0], -1)] * (3 - len(chunk))
+            triplet_view.append([at for at, _ in chunk])
+            triplet_coef.append(np.concatenate([coef[e] if e >= 0 else np.zeros(4) for _, e in chunk]))
+        ptr.append(len(triplet_view))
+    return PlatePlan(views, np.array(groups, dtype=np.int64).reshape(-1, 5), np.array(ptr, dtype=np.int64),
+                     np.array(triplet_view, dtype=np.int64).reshape(-1, 3), np.array(triplet_coef).reshape(-1, 12),
+                     np.flatnonzero(~covered).astype(np.int64), offset, output)
 
 
 @njit
-def apply_stencils(index, coef, lo, hi, u, f):
-    """Add the stencil entries ``lo:hi`` applied to ``u`` into ``f`` (``f`` zeroed by the caller).
+def gather_views(views, lo, hi, u, vx, vy):
+    """Copy the displacement of the views ``lo:hi`` into the view arrays (ghosts included).
 
     Parameters
     ----------
-    index, coef : numpy.ndarray
-        :class:`PlateStencils` arrays.
+    views : numpy.ndarray
+        int64 [nview, 4] (:class:`PlatePlan`).
     lo, hi : int
-        Entry range.
-    u, f : numpy.ndarray
-        [ndof] displacement and force.
+        View range.
+    u : numpy.ndarray
+        [ndof] displacement.
+    vx, vy : numpy.ndarray
+        [view_size] written.
     """
-    for e in range(lo, hi):
-        start = index[e, _START]
-        p = index[e, _P]
-        c = index[e, _CLASS]
-        nb = index[e, _NB]
-        tstart = index[e, _TSTART]
-        tp = index[e, _TP]
-        tc = index[e, _TCLASS]
-        db = index[e, _DB]
-        a = coef[e, 0]
-        b = coef[e, 1]
-        cc = coef[e, 2]
-        d = coef[e, 3]
-        first = max(0, -db)
-        last = min(nb, nb - db)
-        # literal strides for the common node-per-block counts (constant strides after inlining);
-        # any other count takes the general loop
-        if p == 1 and tp == 1:
-            _passes(first, last, nb, start, 1, c, tstart, 1, tc, db, a, b, cc, d, u, f)
-        elif p == 1 and tp == 3:
-            _passes(first, last, nb, start, 1, c, tstart, 3, tc, db, a, b, cc, d, u, f)
-        elif p == 3 and tp == 1:
-            _passes(first, last, nb, start, 3, c, tstart, 1, tc, db, a, b, cc, d, u, f)
-        elif p == 3 and tp == 3:
-            _passes(first, last, nb, start, 3, c, tstart, 3, tc, db, a, b, cc, d, u, f)
-        else:
-            _passes(first, last, nb, start, p, c, tstart, tp, tc, db, a, b, cc, d, u, f)
+    for v in range(lo, hi):
+        start = views[v, 0]
+        q = views[v, 1]
+        nb = views[v, 2]
+        for c in range(q):
+            o = views[v, 3] + c * (nb + 2)
+            ux = u[start + 2 * c:start + 2 * nb * q:2 * q]
+            uy = u[start + 2 * c + 1:start + 2 * nb * q:2 * q]
+            x = vx[o:o + nb + 2]
+            y = vy[o:o + nb + 2]
+            for b in range(nb):
+                x[b + 1] = ux[b]
+                y[b + 1] = uy[b]
+            x[0] = x[nb]
+            y[0] = y[nb]
+            x[nb + 1] = x[1]
+            y[nb + 1] = y[1]
 
 
-@njit(inline="always")
-def _passes(first, last, nb, start, p, c, tstart, tp, tc, db, a, b, cc, d, u, f):
-    _pass(first, last, start, p, c, tstart, tp, tc, db, a, b, cc, d, u, f)  # no wrap
-    _pass(0, first, start, p, c, tstart, tp, tc, db + nb, a, b, cc, d, u, f)  # wrapped on the left
-    _pass(last, nb, start, p, c, tstart, tp, tc, db - nb, a, b, cc, d, u, f)  # wrapped on the right
+@njit
+def _triplet(k, at, vx, vy, o, nb, ox, oy, first):
+    # three stencil entries applied along the group's blocks: contiguous loads and stores (slices:
+    # non-negative loop indices, no wrap-around test), coefficients in registers
+    a1, b1, c1, d1 = k[0], k[1], k[2], k[3]
+    a2, b2, c2, d2 = k[4], k[5], k[6], k[7]
+    a3, b3, c3, d3 = k[8], k[9], k[10], k[11]
+    x1, y1 = vx[at[0]:at[0] + nb], vy[at[0]:at[0] + nb]
+    x2, y2 = vx[at[1]:at[1] + nb], vy[at[1]:at[1] + nb]
+    x3, y3 = vx[at[2]:at[2] + nb], vy[at[2]:at[2] + nb]
+    fx, fy = ox[o:o + nb], oy[o:o + nb]
+    if first:
+        for b in range(nb):
+            fx[b] = ((a1 * x1[b] + b1 * y1[b]) + (a2 * x2[b] + b2 * y2[b])) + (a3 * x3[b] + b3 * y3[b])
+            fy[b] = ((c1 * x1[b] + d1 * y1[b]) + (c2 * x2[b] + d2 * y2[b])) + (c3 * x3[b] + d3 * y3[b])
+    else:
+        for b in range(nb):
+            fx[b] += ((a1 * x1[b] + b1 * y1[b]) + (a2 * x2[b] + b2 * y2[b])) + (a3 * x3[b] + b3 * y3[b])
+            fy[b] += ((c1 * x1[b] + d1 * y1[b]) + (c2 * x2[b] + d2 * y2[b])) + (c3 * x3[b] + d3 * y3[b])
+
+
+@njit
+def apply_groups(groups, triplet_ptr, triplet_view, triplet_coef, lo, hi, vx, vy, ox, oy, f):
+    """The product's rows of the groups ``lo:hi`` from the views, written into ``f``.
+
+    Parameters
+    ----------
+    groups, triplet_ptr, triplet_view, triplet_coef : numpy.ndarray
+        :class:`PlatePlan` arrays.
+    lo, hi : int
+        Group range.
+    vx, vy : numpy.ndarray
+        [view_size] views (:func:`gather_views`).
+    ox, oy : numpy.ndarray
+        [output_size] work arrays.
+    f : numpy.ndarray
+        [ndof] the groups' DOFs are overwritten.
+    """
+    for g in range(lo, hi):
+        start = groups[g, 0]
+        p = groups[g, 1]
+        c = groups[g, 2]
+        nb = groups[g, 3]
+        o = groups[g, 4]
+        for t in range(triplet_ptr[g], triplet_ptr[g + 1]):
+            if t == triplet_ptr[g]:
+                _triplet(triplet_coef[t], triplet_view[t], vx, vy, o, nb, ox, oy, True)
+            else:
+                _triplet(triplet_coef[t], triplet_view[t], vx, vy, o, nb, ox, oy, False)
+        fx = f[start + 2 * c:start + 2 * nb * p:2 * p]
+        fy = f[start + 2 * c + 1:start + 2 * nb * p:2 * p]
+        for b in range(nb):
+            fx[b] = ox[o + b]
+            fy[b] = oy[o + b]
+
+
+@njit
+def plate_product(views, groups, triplet_ptr, triplet_view, triplet_coef, empty_dofs, work, u, f):
+    """``f = K u``: the plates' stiffness product by the stencils (serial).
+
+    Parameters
+    ----------
+    views, groups, triplet_ptr, triplet_view, triplet_coef, empty_dofs : numpy.ndarray
+        :class:`PlatePlan` arrays.
+    work : numpy.ndarray
+        float64 [4, max(view_size, output_size)] work arrays.
+    u, f : numpy.ndarray
+        [ndof] displacement, force (written).
+    """
+    gather_views(views, 0, views.shape[0], u, work[0], work[1])
+    apply_groups(groups, triplet_ptr, triplet_view, triplet_coef, 0, groups.shape[0], work[0], work[1], work[2],
+                 work[3], f)
+    for i in empty_dofs:
+        f[i] = 0.0
