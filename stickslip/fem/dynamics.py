@@ -22,28 +22,32 @@ from .forces import compute_force
 __all__ = ["time_step", "residual"]
 
 
+# The loops run over slices (non-negative indices: no wrap-around test), so that they vectorise.
+
 @njit
 def _predict(lo, hi, dt, u, v, a):
-    for i in range(lo, hi):
-        u[i] += dt * v[i] + 0.5 * dt * dt * a[i]
+    uu, vv, aa = u[lo:hi], v[lo:hi], a[lo:hi]
+    for i in range(hi - lo):
+        uu[i] += dt * vv[i] + 0.5 * dt * dt * aa[i]
 
 
 @njit
 def _correct(lo, hi, dt, mass_inv, damping, f, v, a):
-    for i in range(lo, hi):
-        minv = mass_inv[i]
-        d = damping[i]
-        fi = f[i]
-        v_n = v[i]
-        a_n = a[i]
+    mm, dd, ff, vv, aa = mass_inv[lo:hi], damping[lo:hi], f[lo:hi], v[lo:hi], a[lo:hi]
+    for i in range(hi - lo):
+        minv = mm[i]
+        d = dd[i]
+        fi = ff[i]
+        v_n = vv[i]
+        a_n = aa[i]
         vi = v_n + dt * a_n
         ai = -(fi + d * vi) * minv
         vi = v_n + 0.5 * dt * (a_n + ai)
         ai = -(fi + d * vi) * minv
         vi = v_n + 0.5 * dt * (a_n + ai)
         ai = -(fi + d * vi) * minv
-        v[i] = vi
-        a[i] = ai
+        vv[i] = vi
+        aa[i] = ai
 
 
 # Parallel variants over blocks of DOFs (plain arrays: numba loses writes to named-tuple fields in prange).

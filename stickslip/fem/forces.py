@@ -19,8 +19,8 @@ import numpy as np
 from numba import prange
 
 from ..numba_options import njit
-from .materials import cusp_stress, equivalent_strain, well_index
-from .quad4 import element_strain
+from .interface import interface_force
+from .materials import equivalent_strain, well_index
 from .structured import apply_groups, gather_views, plate_product
 
 __all__ = ["plates", "compute_force", "compute_force_in_wells", "wells_hold", "layer_ubar"]
@@ -35,36 +35,6 @@ def _plates_rows(lo, hi, ptr, col, val, u, f):
         f[i] = s
 
 
-@njit
-def _interface_elements(lo, hi, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe, update_wells):
-    ue = np.empty(8)
-    for e in range(lo, hi):
-        for a in range(8):
-            ue[a] = u[iface_dofs[e, a]]
-        element_strain(dNdx[e], ue, eps[e])
-        for a in range(8):
-            fe[e, a] = 0.0
-        for q in range(4):
-            xx = eps[e, q, 0]
-            yy = eps[e, q, 1]
-            xy = eps[e, q, 2]
-            i = idx[e, q]
-            if update_wells:
-                i = well_index(epsy[e], equivalent_strain(xx, yy, xy), i)
-                idx[e, q] = i
-            eps_min = 0.5 * (epsy[e, i] + epsy[e, i + 1])
-            sxx, syy, sxy = cusp_stress(xx, yy, xy, K, G, eps_min)
-            sig[e, q, 0] = sxx
-            sig[e, q, 1] = syy
-            sig[e, q, 2] = sxy
-            dV = iface_dV[e, q]
-            for m in range(4):
-                gx = dNdx[e, q, m, 0]
-                gy = dNdx[e, q, m, 1]
-                fe[e, 2 * m] += dV * (gx * sxx + gy * sxy)
-                fe[e, 2 * m + 1] += dV * (gx * sxy + gy * syy)
-
-
 # Parallel variants: blocks of rows / elements, each computed exactly as serially (so the
 # result does not depend on the number of threads). They take plain arrays: numba loses
 # writes to named-tuple fields inside prange.
@@ -77,12 +47,11 @@ def _plates_rows_parallel(nblock, ptr, col, val, u, f):
 
 
 @njit(parallel=True)
-def _interface_elements_parallel(nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u, idx, eps, sig, fe,
-                                 update_wells):
+def _interface_force_parallel(nblock, iface_dofs, grad, volume, epsy, K, G, u, idx, inp, out, update_wells):
     n = iface_dofs.shape[0]
     for b in prange(nblock):
-        _interface_elements(b * n // nblock, (b + 1) * n // nblock, iface_dofs, dNdx, iface_dV, epsy, K, G, u,
-                            idx, eps, sig, fe, update_wells)
+        interface_force(b * n // nblock, (b + 1) * n // nblock, iface_dofs, grad, volume, epsy, K, G, u, idx, inp,
+                        out, update_wells)
 
 
 @njit(parallel=True)
@@ -159,14 +128,20 @@ def _force(model, state, fe, update_wells):
     m = model
     plates(m, state.u, state.f)
     if m.nblock > 1:
-        _interface_elements_parallel(m.nblock, m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G, state.u,
-                                     state.idx, state.eps, state.sig, fe, update_wells)
+        _interface_force_parallel(m.nblock, m.iface_dofs, m.iface_grad, m.iface_volume, m.epsy, m.K, m.G, state.u,
+                                  state.idx, m.iface_in, m.iface_out, update_wells)
     else:
-        _interface_elements(0, m.iface_dofs.shape[0], m.iface_dofs, m.iface_dNdx, m.iface_dV, m.epsy, m.K, m.G,
-                            state.u, state.idx, state.eps, state.sig, fe, update_wells)
-    for e in range(model.iface_dofs.shape[0]):
+        interface_force(0, m.iface_dofs.shape[0], m.iface_dofs, m.iface_grad, m.iface_volume, m.epsy, m.K, m.G,
+                        state.u, state.idx, m.iface_in, m.iface_out, update_wells)
+    out = m.iface_out
+    for e in range(m.iface_dofs.shape[0]):
+        for q in range(4):
+            for c in range(3):
+                state.eps[e, q, c] = out[3 * q + c, e]
+                state.sig[e, q, c] = out[12 + 3 * q + c, e]
         for a in range(8):
-            state.f[model.iface_dofs[e, a]] += fe[e, a]
+            fe[e, a] = out[24 + a, e]
+            state.f[m.iface_dofs[e, a]] += fe[e, a]
     _drive(model, state)
 
 

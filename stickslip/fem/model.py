@@ -12,6 +12,7 @@ import numpy as np
 
 from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, layer_average_weights,
                        lumped_diagonal)
+from .interface import NIN, NOUT, interface_layout
 from .quad4 import element_coordinates, shape_gradients
 from .structured import build_stencils, plan_product
 
@@ -36,6 +37,10 @@ Model = namedtuple("Model", [
     "iface_dofs",     # int64 [ni, 8]: DOFs of the interface elements (interface by interface, blocks left to right)
     "iface_dNdx",     # float64 [ni, 4, 4, 2] [1/length]
     "iface_dV",       # float64 [ni, 4] [length^2]
+    "iface_grad",     # float64 [32, ni]: iface_dNdx field by field (:func:`.interface.interface_layout`)
+    "iface_volume",   # float64 [4, ni]: iface_dV field by field
+    "iface_in",       # float64 [NIN, ni]: scratch of the interface kernel (:mod:`.interface`)
+    "iface_out",      # float64 [NOUT, ni]: its strain, stress and element force rows
     "epsy",           # float64 [ni, ny]: yield strains per interface element [strain]
     "K", "G",         # float: moduli [stress]
     "layer_ptr",      # int64 [nlayer + 1]: slices of layer_xdofs / layer_w
@@ -119,6 +124,7 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     if plate_kernel not in PLATE_KERNELS:
         raise ValueError(f"plate_kernel {plate_kernel!r}: expected one of {PLATE_KERNELS}")
     plan = plan_product(build_stencils(mesh, k_ptr, k_col, k_val), ndof)
+    iface_grad, iface_volume = interface_layout(dNdx[iface], dV[iface])
     nblock = 4 * int(threads) if threads > 1 else 1
     nelem = conn.shape[0]
     mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
@@ -143,7 +149,8 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
         plate_work=np.zeros((4, max(plan.view_size, plan.output_size))),
         mass_inv=mass_inv, damping=damping,
         prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
-        iface_dV=dV[iface], epsy=np.ascontiguousarray(epsy, dtype=np.float64), K=float(K), G=float(G),
+        iface_dV=dV[iface], iface_grad=iface_grad, iface_volume=iface_volume, iface_in=np.zeros((NIN, iface.size)),
+        iface_out=np.zeros((NOUT, iface.size)), epsy=np.ascontiguousarray(epsy, dtype=np.float64), K=float(K), G=float(G),
         layer_ptr=np.asarray(ptr, dtype=np.int64), layer_xdofs=np.concatenate(xdofs),
         layer_w=np.concatenate(weights), layer_volume=np.asarray(volume),
         drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),
