@@ -7,8 +7,11 @@ Usage::
     python benchmarks/bench_fem.py --N 1458 --plates 6 --linear-response
 
 Per-step mode: time steps right after a kick (blocks yielding), with the assembled plate
-product (the reference) and with the structured kernel; last lines
-``kernel_speedup=<assembled/structured>`` and ``time_per_step_us=<structured>``. It loads
+product (the reference) and with the structured kernel; then the cost of each component of a
+step (plate product, interface elements incl. the well search, drive, the two Verlet updates,
+and the residual that a minimisation adds per step), as wall time and as CPU time of this
+process (less distorted when the machine is shared); last lines
+``kernel_speedup=<assembled/structured>`` and ``time_per_step_us=<structured>`` (wall time). It loads
 along an affine shear instead of the linear response: the cost of a step does not depend on it.
 
 ``--event``: ``--events`` consecutive events (elastic load step, kick, minimisation with
@@ -32,7 +35,8 @@ import time
 
 import numpy as np
 
-from stickslip.fem.dynamics import time_step
+from stickslip.fem.dynamics import _correct, _predict, residual, time_step
+from stickslip.fem.forces import drive_force, interface_forces, plates
 from stickslip.fem.event_driven import autoscale
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.system import System
@@ -61,27 +65,91 @@ def _affine_response(system):
     system.restore(np.zeros(system.model.ndof), np.zeros(system.mesh.nlayer), 0.0, 0.0)
 
 
-def _time_steps(args, mesh, threads, plate_kernel):
+def _loaded_system(args, mesh, threads, plate_kernel):
+    """A system right after a kick (blocks yielding), loaded along an affine shear."""
     system = System(FemParams(N=args.N, plates=args.plates, nchunk=200), mesh, threads=threads,
                     plate_kernel=plate_kernel)
     _affine_response(system)
     system.event_step(kick=False)
-    index = system.state.idx.copy()
     system.event_step(kick=True)
+    return system
+
+
+def _time_steps(args, mesh, threads, plate_kernel):
+    system = _loaded_system(args, mesh, threads, plate_kernel)
+    index = system.state.idx.copy()
     _steps(system.model, system.state, system._fe, 10)  # warm up (compiles if not cached)
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     _steps(system.model, system.state, system._fe, args.steps)
-    seconds = time.perf_counter() - start
+    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     yielded = int(np.count_nonzero(system.state.idx != index))
     per_step = seconds / args.steps * 1e6
     print(f"{plate_kernel}: steps={args.steps} seconds={seconds:.3f} gauss_points_yielded={yielded} "
-          f"time_per_step_us={per_step:.1f} ns_per_element_step={per_step * 1e3 / mesh.nelem:.1f}")
+          f"time_per_step_us={per_step:.1f} cpu_per_step_us={cpu / args.steps * 1e6:.1f} "
+          f"ns_per_element_step={per_step * 1e3 / mesh.nelem:.1f}")
     return per_step
+
+
+@njit
+def _repeat_plates(model, state, fe, n):
+    for _ in range(n):
+        plates(model, state.u, state.f)
+
+
+@njit
+def _repeat_interfaces(model, state, fe, n):
+    for _ in range(n):
+        interface_forces(model, state, fe, True)
+
+
+@njit
+def _repeat_drive(model, state, fe, n):
+    for _ in range(n):
+        drive_force(model, state)
+
+
+@njit
+def _repeat_predict(model, state, fe, n):
+    for _ in range(n):
+        _predict(0, model.ndof, 0.0, state.u, state.v, state.a)  # dt = 0: same work, state unchanged
+
+
+@njit
+def _repeat_correct(model, state, fe, n):
+    for _ in range(n):
+        _correct(0, model.ndof, model.dt, model.mass_inv, model.damping, state.f, state.v, state.a)
+
+
+@njit
+def _repeat_residual(model, state, fe, n):
+    total = 0.0
+    for _ in range(n):
+        total += residual(model, state)
+    return total
+
+
+def _breakdown(args, mesh, threads):
+    """Time of each component of a step, serial kernels as in a step (``threads`` as given)."""
+    components = (("plates", _repeat_plates), ("interfaces", _repeat_interfaces), ("drive", _repeat_drive),
+                  ("predict", _repeat_predict), ("correct", _repeat_correct), ("residual", _repeat_residual))
+    repeat = max(1, args.steps // 4)
+    for plate_kernel in ("assembled", "structured"):
+        system = _loaded_system(args, mesh, threads, plate_kernel)
+        parts = []
+        for name, kernel in components:
+            if plate_kernel == "structured" or name == "plates":
+                kernel(system.model, system.state, system._fe, 2)  # compile if not cached
+                start, cpu = time.perf_counter(), time.process_time()
+                kernel(system.model, system.state, system._fe, repeat)
+                parts.append(f"{name}={(time.perf_counter() - start) / repeat * 1e6:.1f}/"
+                             f"{(time.process_time() - cpu) / repeat * 1e6:.1f}")
+        print(f"breakdown {plate_kernel} (us per step, wall/cpu): " + " ".join(parts))
 
 
 def _per_step(args, mesh, threads):
     assembled = _time_steps(args, mesh, threads, "assembled")
     structured = _time_steps(args, mesh, threads, "structured")
+    _breakdown(args, mesh, threads)
     print(f"kernel_speedup={assembled / structured:.2f}")
     print(f"time_per_step_us={structured:.1f}")
 

@@ -14,7 +14,7 @@ from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.random import pcg32_uint32, pcg32_uniform
 from stickslip.fem.system import System
-from stickslip.fem.forces import compute_force
+from stickslip.fem.forces import compute_force, compute_force_in_wells
 from stickslip.fem.yield_strains import interface_initstate, yield_strains
 from stickslip.mesh import MeshParams, build_stack_mesh
 
@@ -185,3 +185,41 @@ def test_linear_response_and_load_step_superpose(stack):
     s.event_step(kick=True)
     assert np.any(s.state.idx != before)
     assert kick * equivalent_strain(*s.delta_eps.reshape(-1, 3).max(axis=0)) < 10 * s.constants["deps"]
+
+
+@pytest.mark.parametrize("update_wells", [True, False])
+def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells):
+    # every interface Gauss point: strain (element_strain), well (well_index) and cusp stress
+    # (cusp_stress) evaluated one by one must give the same bits as the vectorised kernel, with
+    # displacements large enough that many points change well (the recompute path)
+    from stickslip.fem.materials import cusp_stress, well_index
+    from stickslip.fem.quad4 import element_strain
+
+    system = System(FemParams(N=9, plates=3, nchunk=50), build_stack_mesh(MeshParams(N=9, plates=3)))
+    model, state = system.model, new_state(system.model)
+    rng = np.random.default_rng(3)
+    state.u[:] = 2e-3 * rng.standard_normal(model.ndof)
+    state.idx[:] = rng.integers(0, 5, state.idx.shape)
+    before = state.idx.copy()
+    fe = np.zeros((model.iface_dofs.shape[0], 8))
+    compute_force(model, state, fe) if update_wells else compute_force_in_wells(model, state, fe)
+    moved = 0
+    for e in range(model.iface_dofs.shape[0]):
+        eps = np.zeros((4, 3))
+        element_strain(model.iface_dNdx[e], state.u[model.iface_dofs[e]], eps)
+        force = np.zeros(8)
+        for q in range(4):
+            i = before[e, q]
+            if update_wells:
+                i = well_index(model.epsy[e], equivalent_strain(*eps[q]), i)
+            moved += i != before[e, q]
+            assert state.idx[e, q] == i
+            sig = cusp_stress(*eps[q], model.K, model.G, 0.5 * (model.epsy[e, i] + model.epsy[e, i + 1]))
+            assert state.eps[e, q].tobytes() == eps[q].tobytes()
+            assert state.sig[e, q].tobytes() == np.array(sig).tobytes()
+            for m in range(4):
+                gx, gy = model.iface_dNdx[e, q, m]
+                force[2 * m] += model.iface_dV[e, q] * (gx * sig[0] + gy * sig[2])
+                force[2 * m + 1] += model.iface_dV[e, q] * (gx * sig[2] + gy * sig[1])
+        assert fe[e].tobytes() == force.tobytes()
+    assert (moved > 10) == update_wells

@@ -8,7 +8,7 @@ from stickslip.fem.forces import compute_force, plates
 from stickslip.fem.model import new_state
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.quad4 import element_coordinates, shape_gradients
-from stickslip.fem.structured import build_stencils, plan_product, plate_product
+from stickslip.fem.structured import balanced_blocks, build_stencils, plan_product, plate_product
 from stickslip.fem.system import System
 from stickslip.mesh import MeshParams, build_stack_mesh
 
@@ -76,3 +76,12 @@ def test_parallel_product_has_the_serial_bits(threads):
     plates(serial, u, f_serial)
     plates(parallel, u, f_parallel)
     assert f_serial.tobytes() == f_parallel.tobytes()
+
+
+def test_balanced_blocks_split_the_work_evenly():
+    work = np.array([1, 1, 10, 1, 1, 1, 1, 1, 1, 1, 1, 10])
+    bounds = balanced_blocks(work, 3)
+    assert bounds[0] == 0 and bounds[-1] == work.size and np.all(np.diff(bounds) >= 0)
+    totals = [work[a:b].sum() for a, b in zip(bounds[:-1], bounds[1:])]
+    assert max(totals) <= work.sum() / 3 + work.max()
+    assert list(balanced_blocks(work, 100)[[0, -1]]) == [0, work.size]

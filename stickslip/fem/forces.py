@@ -23,7 +23,7 @@ from .interface import interface_force
 from .materials import equivalent_strain, well_index
 from .structured import apply_groups, gather_views, plate_product
 
-__all__ = ["plates", "compute_force", "compute_force_in_wells", "wells_hold", "layer_ubar"]
+__all__ = ["plates", "interface_forces", "drive_force", "compute_force", "compute_force_in_wells", "wells_hold", "layer_ubar"]
 
 
 @njit
@@ -55,13 +55,12 @@ def _interface_force_parallel(nblock, iface_dofs, grad, volume, epsy, K, G, u, i
 
 
 @njit(parallel=True)
-def _plate_product_parallel(nblock, views, groups, triplet_ptr, triplet_view, triplet_coef, empty, work, u, f):
-    nview = views.shape[0]
-    for b in prange(nblock):
-        gather_views(views, b * nview // nblock, (b + 1) * nview // nblock, u, work[0], work[1])
-    ngroup = groups.shape[0]
-    for b in prange(nblock):
-        apply_groups(groups, triplet_ptr, triplet_view, triplet_coef, b * ngroup // nblock, (b + 1) * ngroup // nblock,
+def _plate_product_parallel(view_blocks, group_blocks, views, groups, triplet_ptr, triplet_view, triplet_coef, empty,
+                            work, u, f):
+    for b in prange(view_blocks.size - 1):
+        gather_views(views, view_blocks[b], view_blocks[b + 1], u, work[0], work[1])
+    for b in prange(group_blocks.size - 1):
+        apply_groups(groups, triplet_ptr, triplet_view, triplet_coef, group_blocks[b], group_blocks[b + 1],
                      work[0], work[1], work[2], work[3], f)
     for i in empty:
         f[i] = 0.0
@@ -81,8 +80,9 @@ def plates(model, u, f):
     """
     m = model
     if m.structured and m.nblock > 1:
-        _plate_product_parallel(m.nblock, m.plate_views, m.plate_groups, m.plate_triplet_ptr, m.plate_triplet_view,
-                                m.plate_triplet_coef, m.plate_empty, m.plate_work, u, f)
+        _plate_product_parallel(m.plate_view_blocks, m.plate_group_blocks, m.plate_views, m.plate_groups,
+                                m.plate_triplet_ptr, m.plate_triplet_view, m.plate_triplet_coef, m.plate_empty,
+                                m.plate_work, u, f)
     elif m.structured:
         plate_product(m.plate_views, m.plate_groups, m.plate_triplet_ptr, m.plate_triplet_view, m.plate_triplet_coef,
                       m.plate_empty, m.plate_work, u, f)
@@ -103,7 +103,8 @@ def layer_ubar(model, u, out):
 
 
 @njit
-def _drive(model, state):
+def drive_force(model, state):
+    """Add the drive springs' force to ``state.f`` (layer averages ``state.ubar`` and, free lever, targets)."""
     layer_ubar(model, state.u, state.ubar)
     if model.free_lever:
         num = state.lever[0]
@@ -124,9 +125,19 @@ def _drive(model, state):
 
 
 @njit
-def _force(model, state, fe, update_wells):
+def interface_forces(model, state, fe, update_wells):
+    """Add the interface elements' force to ``state.f``; write ``state.eps``, ``state.sig`` (and ``state.idx``).
+
+    Parameters
+    ----------
+    model : Model
+    state : State
+    fe : numpy.ndarray
+        [ni, 8] written: the element forces, added to ``state.f`` in element order.
+    update_wells : bool
+        Move Gauss points to the well of their strain (else they keep ``state.idx``).
+    """
     m = model
-    plates(m, state.u, state.f)
     if m.nblock > 1:
         _interface_force_parallel(m.nblock, m.iface_dofs, m.iface_grad, m.iface_volume, m.epsy, m.K, m.G, state.u,
                                   state.idx, m.iface_in, m.iface_out, update_wells)
@@ -142,7 +153,13 @@ def _force(model, state, fe, update_wells):
         for a in range(8):
             fe[e, a] = out[24 + a, e]
             state.f[m.iface_dofs[e, a]] += fe[e, a]
-    _drive(model, state)
+
+
+@njit
+def _force(model, state, fe, update_wells):
+    plates(model, state.u, state.f)
+    interface_forces(model, state, fe, update_wells)
+    drive_force(model, state)
 
 
 @njit

@@ -14,7 +14,7 @@ from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, la
                        lumped_diagonal)
 from .interface import NIN, NOUT, interface_layout
 from .quad4 import element_coordinates, shape_gradients
-from .structured import build_stencils, plan_product
+from .structured import build_stencils, plan_blocks, plan_product
 
 __all__ = ["Model", "State", "PLATE_KERNELS", "build_model", "new_state"]
 
@@ -30,6 +30,8 @@ Model = namedtuple("Model", [
     "plate_triplet_coef",  # float64 [ntriplet, 12]
     "plate_empty",    # int64 [nempty]: DOFs with an empty plate row
     "plate_work",     # float64 [4, nwork]: scratch of the structured product (views x, y; rows x, y)
+    "plate_view_blocks",   # int64 [nblock + 1]: view ranges of the parallel blocks (balanced)
+    "plate_group_blocks",  # int64 [nblock + 1]: group ranges of the parallel blocks (balanced)
     "mass_inv",       # float64 [ndof]: 1 / lumped mass on free DOFs, 0 on prescribed DOFs
     "damping",        # float64 [ndof]: lumped background damping [mass / time]
     "prescribed",     # bool [ndof]
@@ -126,6 +128,7 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     plan = plan_product(build_stencils(mesh, k_ptr, k_col, k_val), ndof)
     iface_grad, iface_volume = interface_layout(dNdx[iface], dV[iface])
     nblock = 4 * int(threads) if threads > 1 else 1
+    view_blocks, group_blocks = plan_blocks(plan, nblock)
     nelem = conn.shape[0]
     mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
     damping = lumped_diagonal(xe, edofs, np.full(nelem, alpha), ndof)
@@ -146,7 +149,8 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
         ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, structured=plate_kernel == "structured",
         plate_views=plan.views, plate_groups=plan.groups, plate_triplet_ptr=plan.triplet_ptr,
         plate_triplet_view=plan.triplet_view, plate_triplet_coef=plan.triplet_coef, plate_empty=plan.empty_dofs,
-        plate_work=np.zeros((4, max(plan.view_size, plan.output_size))),
+        plate_work=np.zeros((4, max(plan.view_size, plan.output_size))), plate_view_blocks=view_blocks,
+        plate_group_blocks=group_blocks,
         mass_inv=mass_inv, damping=damping,
         prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
         iface_dV=dV[iface], iface_grad=iface_grad, iface_volume=iface_volume, iface_in=np.zeros((NIN, iface.size)),
