@@ -23,7 +23,7 @@ period ``q`` at which the line is read, into contiguous *views* with one periodi
 on each side (:func:`gather_views`); (2) the rows of each line and class (a *group*) are
 summed from its entries three at a time, each pass a contiguous loop over the blocks with
 the twelve coefficients in registers, which LLVM vectorises (:func:`apply_groups`); (3) the
-group's x and y rows are written back into the interleaved force. Measured 5.7x faster than
+group's x and y rows are written back into the interleaved force. Measured 6x faster than
 the CSR product at N = 1458 (docs/benchmarks.md).
 """
 
