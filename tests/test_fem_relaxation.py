@@ -1,5 +1,7 @@
 """The exact relaxation (``relaxation = exact``): equilibrium within fixed wells, direct linear response, runs."""
 
+import math
+
 import h5py
 import numpy as np
 import pandas as pd
@@ -10,7 +12,7 @@ from stickslip.fem.dynamics import residual
 from stickslip.fem.forces import compute_force, wells_hold
 from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.system import System
+from stickslip.fem.system import System, derived_constants
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
 
@@ -88,6 +90,15 @@ def test_exact_relaxation_quenches_a_kick_in_far_fewer_steps():
     assert steps["exact"] * 10 < steps["dynamic"]
 
 
+@pytest.mark.parametrize("N, dt_scale, steps", [(9, 1.0, 267), (162, 1.0, 4799), (162, 2.0, 2400), (1458, 1.0, 43185)])
+def test_the_automatic_quiet_window_is_a_shear_wave_crossing_a_third_of_the_interface(N, dt_scale, steps):
+    # L = N h (h = pi), c_s = sqrt(G / 2 rho) = 1/sqrt(2), dt = 0.05 dt_scale: L / (3 c_s dt) rounded up
+    mesh = build_stack_mesh(MeshParams(N=N, plates=2))
+    assert derived_constants(FemParams(N=N, dt_scale=dt_scale, relaxation="exact"), mesh)["quiet_steps"] == steps
+    assert 0 <= steps - N * math.pi * math.sqrt(2.0) / 3.0 / (0.05 * dt_scale) < 1
+    assert derived_constants(FemParams(N=N, quiet_steps=200, relaxation="exact"), mesh)["quiet_steps"] == 200
+
+
 def _run(output, **values):
     plugin = registry.get("solver", "fem")
     params = parse_params(plugin.params, {**CASE, "relaxation": "exact", "max_increments": 120, **values})
@@ -100,7 +111,7 @@ def test_exact_runs_are_reproducible_resume_identically_and_record_the_relaxatio
     _run(second)
     assert first.read_bytes() == second.read_bytes()
     attrs = read_run_attrs(first)
-    assert attrs["params"]["relaxation"] == "exact" and attrs["params"]["quiet_steps"] == 200
+    assert attrs["params"]["relaxation"] == "exact" and attrs["params"]["quiet_steps"] == 0
     # interrupted in the middle of the 31st kick (as by Ctrl-C), then resumed
     partial = tmp_path / "partial.h5"
     kick = System.kick

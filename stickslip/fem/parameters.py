@@ -62,8 +62,10 @@ class FemParams:
                                        "solved directly once no well changed for quiet_steps, accepted only if every "
                                        "Gauss point stays in its well; linear response by a direct solve)",
                             choices=RELAXATIONS)
-    quiet_steps: int = param(200, "relaxation 'exact': time steps without any well change before an equilibrium "
-                                  "solve is tried (and between tries)", minimum=1)
+    quiet_steps: int = param(0, "relaxation 'exact': time steps without any well change before an equilibrium "
+                                "solve is tried (and between tries); 0: the time a shear wave takes to cross a "
+                                "third of the interface, L / (3 c_s), about 30 N steps at dt_scale 1 (shorter "
+                                "windows end events early: docs/fem.md)", minimum=0)
     margin: int = param(5, "a block within this many wells of the end of its held sequence stops the run "
                            "('stop') or makes the event be redone with more wells held ('extend')", minimum=1)
     lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",

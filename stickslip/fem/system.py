@@ -43,16 +43,22 @@ def derived_constants(params, mesh):
         ``L`` (periodic length), ``c`` = sqrt(G / rho), ``c_s`` = sqrt(G / 2 / rho)
         (shear-wave speed), ``alpha`` = sqrt(2) (2 pi / L) c rho (critical damping of
         the shear wave of wavelength L), ``dt`` = ``dt_scale`` h / (2 pi c) / 10, ``sig0`` = 2 G eps0,
-        ``deps`` (kick, strain), ``H`` (free-lever drive height).
+        ``deps`` (kick, strain), ``H`` (free-lever drive height), ``quiet_steps`` (the
+        exact relaxation's quiet window in time steps: ``params.quiet_steps``, or if that
+        is 0 the shear-wave transit time over a third of the interface, ``L / (3 c_s)``,
+        rounded up to whole steps).
     """
     h = float(mesh.h)
     L = mesh.N * h
     c = math.sqrt(params.G / params.rho)
+    c_s = math.sqrt(params.G / 2.0 / params.rho)
+    dt = params.dt_scale * (1.0 / (c * 2.0 * math.pi / h)) / 10.0
     heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
     return {
-        "h": h, "L": L, "c": c, "c_s": math.sqrt(params.G / 2.0 / params.rho),
+        "h": h, "L": L, "c": c, "c_s": c_s,
         "alpha": math.sqrt(2.0) * (2.0 * math.pi / L) * c * params.rho,
-        "dt": params.dt_scale * (1.0 / (c * 2.0 * math.pi / h)) / 10.0,
+        "dt": dt,
+        "quiet_steps": params.quiet_steps or math.ceil(L / (3.0 * c_s) / dt),
         "sig0": 2.0 * params.G * params.eps0,
         "deps": params.deps * params.eps0,
         "H": params.lever_height * float(heights[1] - heights[0]),
@@ -218,10 +224,10 @@ class System:
 
         ``relaxation = dynamic``: damped dynamics until the residual criterion (the
         paper's protocol). ``relaxation = exact``: the same dynamics, interrupted once
-        ``quiet_steps`` steps changed no well index; then the equilibrium of the current
+        ``constants["quiet_steps"]`` steps changed no well index; then the equilibrium of the current
         wells is solved (:meth:`relax_in_wells`) and accepted if every Gauss point of it
         lies in its current well, otherwise the dynamics continue (and a solve is tried
-        again after the next ``quiet_steps`` steps without a change). When the residual
+        again after the next quiet window). When the residual
         criterion is met first, the solve is tried too (its result, if accepted, replaces
         the quenched state). The state's time ``t`` counts the time steps made.
 
@@ -245,7 +251,7 @@ class System:
             If ``max_iter`` steps do not converge.
         """
         p = self.params
-        quiet = p.quiet_steps if p.relaxation == "exact" else 0
+        quiet = self.constants["quiet_steps"] if p.relaxation == "exact" else 0
         total = 0
         found = []
         while True:
