@@ -1,4 +1,4 @@
-"""Integrators of the rate-and-state lever: steps, time per step and results, ROS2 against scipy's Radau.
+"""Integrators of the rate-and-state lever: steps, time per step and results, RODAS4 against scipy's methods.
 
     python benchmarks/bench_rate_state.py [DURATION]
 
@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from stickslip.experiment.virtual import Apparatus
-from stickslip.experiment.virtual.slab_dynamics import SlabDynamics
+from stickslip.experiment.virtual.slab_dynamics import METHODS, SlabDynamics
 from stickslip.params import parse_params
 from stickslip.solvers.rate_state_lever import RateStateLeverParams, law_of
 
@@ -27,7 +27,7 @@ def main(duration):
     dynamics = SlabDynamics(apparatus, law_of(params), params.slab_mass, params.load_mass)
     _, y0 = dynamics.initial_state(params.V_start, params.theta_start, params.gamma_start)
     print(f"{'method':8s} {'steps':>8s} {'wall [s]':>9s} {'us/step':>8s} {'T [s]':>9s} {'dR [mm]':>8s}")
-    for method in ("ROS2", "Radau", "BDF", "LSODA"):
+    for method in METHODS:
         try:
             dynamics.integrate(y0, 1.0, apparatus.shear_rate, method=method)  # compile
             start = time.perf_counter()

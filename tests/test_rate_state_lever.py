@@ -12,9 +12,12 @@ from stickslip.experiment.analysis import analyse_record
 from stickslip.experiment.timeseries import read_timeseries, read_truth
 from stickslip.experiment.virtual import Apparatus
 from stickslip.experiment.virtual.rate_state import RateStateLaw
-from stickslip.experiment.virtual import slab_dynamics
+from stickslip.experiment.virtual import rosenbrock, slab_dynamics
 from stickslip.experiment.virtual.slab_dynamics import SlabDynamics
+from stickslip.experiment.virtual.slab_equations import rhs
+from stickslip.experiment.virtual.slab_linear_system import factorize, new_factors, solve
 from stickslip.params import parse_params
+from stickslip.solvers import rate_state_lever
 
 N, H, h = 49.0, 100.0, 10.0
 LAW = RateStateLaw(a=np.full(5, 0.013), b=np.full(5, 0.019), D_c=np.full(5, 5e-4), mu0=np.full(5, 0.35), V0=1e-3)
@@ -140,6 +143,65 @@ def test_integration_reports_simulated_time_rate_time_left_and_steps(monkeypatch
     assert len(lines) > 10 and done == sorted(done) and done[0] == 0 and done[-1] == 120
     assert re.match(rf"virtual experiment: 120/120 s simulated \(100%\) \[[0-9:]+ elapsed, [0-9:]+ left, "
                     rf"+[0-9.]+ s simulated/s, {t.size - 1} steps\]$", lines[-1])
+
+
+def test_the_structured_solve_equals_a_dense_solve_of_the_whole_system():
+    """(I - c J) u = r solved through the m x m Schur complement (slab_linear_system) equals LAPACK's
+    dense solve of the (3 m + 1)-dimensional system, at states of sticks and slips (stack n = 3) and
+    step sizes from 1e-9 s to 1 s, to 1e-9 of the solution."""
+    apparatus = Apparatus.from_protocol("stack", n=3, a=0, n_slabs=5, k_spring=55.0, normal_force=N, h=h, H=H,
+                                        V=0.01, gamma_start=-0.3)
+    dynamics = SlabDynamics(apparatus, LAW, 0.143, 5.0)
+    t, y, _ = _stack_n3(300.0)
+    args = (apparatus.shear_rate, *dynamics._arrays())
+    rng = np.random.default_rng(0)
+    states = y[np.linspace(0, t.size - 1, 40).astype(int)]
+    states = np.vstack([states, y[np.abs(y[:, 3:6]).max(axis=1).argmax()]])  # the fastest slip
+    assert np.abs(states[:, 3:6]).max() > 1.0 and np.abs(states[:, 3:6]).min() < 1e-4
+    factors = new_factors(3)
+    for state in states:
+        for c in (1e-9, 1e-6, 1e-3, 1.0):
+            r = rng.standard_normal(state.size)
+            u = np.empty(state.size)
+            factorize(state, c, factors, *args)
+            solve(r, u, c, factors, *args)
+            dense = np.linalg.solve(np.eye(state.size) - c * dynamics.jacobian(state, apparatus.shear_rate), r)
+            np.testing.assert_allclose(u, dense, rtol=0, atol=1e-9 * np.abs(dense).max())
+
+
+def test_rodas4_has_order_four_and_an_order_three_error_estimate():
+    """One step of size h = 0.03 s and h/3 on a slab in stick-slip (K = K_c/2, mid-oscillation): the
+    local error against a Radau reference falls as h^5 and the embedded error estimate as h^4
+    (measured exponents 5.3 and 4.2, asserted within 0.4); a wrong tableau coefficient breaks the order."""
+    apparatus, dynamics, y0, spring_speed = _one_slab(0.5 * K_C, V=0.1)
+    y0[1] *= 0.5
+    _, y, _ = dynamics.integrate(y0, 1.0, apparatus.shear_rate, rtol=1e-10)
+    start = y[-1]
+    args = (apparatus.shear_rate, *dynamics._arrays())
+    tableau = rosenbrock.TABLEAUX["RODAS4"]
+    errors, estimates = [], []
+    for step in (0.03, 0.01):
+        _, exact, _ = dynamics.integrate(start, step, apparatus.shear_rate, method="Radau", rtol=1e-13)
+        y_new, error = np.empty(start.size), np.empty(start.size)
+        rosenbrock.step(start, rhs(start, *args), step, *tableau.arrays()[:5], np.empty((tableau.weights.size, 4)),
+                        y_new, error, np.empty((2, 4)), new_factors(1), args)
+        errors.append(abs(y_new[1] - exact[-1, 1]))
+        estimates.append(abs(error[1]))
+    assert np.log(errors[0] / errors[1]) / np.log(3) == pytest.approx(5, abs=0.4)
+    assert np.log(estimates[0] / estimates[1]) / np.log(3) == pytest.approx(4, abs=0.4)
+
+
+def test_the_default_tolerance_resolves_the_slips_to_the_sensor_resolution():
+    """Individual protocol (periodic): the default integration (RODAS4, rtol 1e-4) and a reference at
+    rtol 1e-8 have the same slips, onsets within one force sample (0.02 s) and dmu, dR within 1e-4
+    (force noise: 0.002 in mu; camera noise: 0.002 mm)."""
+    plugin = registry.get("solver", "rate-state-lever")
+    values = {"protocol": "individual", "n": 1, "a": 1, "duration": 1500.0}
+    default, reference = (rate_state_lever.simulate(parse_params(plugin.params, dict(values, rtol=rtol)))[1]
+                          for rtol in (1e-4, 1e-8))
+    assert len(default) == len(reference) >= 5
+    for column, tolerance in (("t_start", 0.02), ("dmu", 1e-4), ("dR", 1e-4)):
+        np.testing.assert_allclose(default[column], reference[column], rtol=0, atol=tolerance)
 
 
 def _simulate(tmp_path, name, **values):

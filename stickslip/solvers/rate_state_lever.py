@@ -32,7 +32,7 @@ from .lever import LeverParams, check_protocol
 
 __all__ = ["RateStateLeverParams", "run", "simulate", "law_of"]
 
-VERSION = "1"
+VERSION = "2"  # 2: RODAS4 with relative slip-rate tolerances (issue 12, third session)
 
 #: Parameters shared with the ``lever`` solver: apparatus, protocol, drive, sensors.
 SHARED = ("n", "protocol", "a", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",
@@ -66,9 +66,10 @@ _OWN = [
     ("V_start", float, param(1e-6, "slip rate of every interface at t = 0", unit="mm/s", exclusive_minimum=0)),
     ("slip_velocity", float, param(0.1, "slip rate above which the ground truth counts a slip", unit="mm/s",
                                    exclusive_minimum=0)),
-    ("method", str, param(DEFAULT_METHOD, "implicit integrator (ROS2: compiled Rosenbrock; others: scipy solve_ivp)",
+    ("method", str, param(DEFAULT_METHOD, "implicit integrator (RODAS4: compiled Rosenbrock; others: scipy solve_ivp)",
                           choices=METHODS)),
-    ("rtol", float, param(1e-4, "relative tolerance of the integrator", exclusive_minimum=0)),
+    ("rtol", float, param(1e-4, "relative tolerance of the integrator (the absolute tolerances scale with it)",
+                          exclusive_minimum=0)),
 ]
 
 

@@ -1,40 +1,145 @@
-"""A compiled L-stable Rosenbrock method (ROS2) with adaptive steps for the slab equations (:mod:`.slab_equations`).
+"""Compiled L-stable Rosenbrock methods with adaptive steps for the slab equations (:mod:`.slab_equations`).
 
-ROS2 (Verwer, Spee, Blom & Hundsdorfer 1999, SIAM J. Sci. Comput. 20, 1456), for ``dy/dt = f(y)``
-with Jacobian ``J``, step ``h``, ``g = 1 + 1/sqrt(2)``::
+A Rosenbrock method of ``s`` stages in the form of Hairer & Wanner (*Solving Ordinary Differential
+Equations II*, 2nd ed., 1996, Sec. IV.7, Eq. (7.25)), for the autonomous ``dy/dt = f(y)`` with
+Jacobian ``J`` and step ``h``::
 
-    (I - g h J) k1 = f(y_n)
-    (I - g h J) k2 = f(y_n + h k1) - 2 k1
-    y_{n+1} = y_n + h (3 k1 + k2) / 2
+    (I - gamma h J) u_i = gamma h f(y_n + sum_{j<i} alpha_ij u_j) + gamma sum_{j<i} Gamma_ij u_j
+    y_{n+1} = y_n + sum_i m_i u_i,        error = sum_i e_i u_i
 
-second order and L-stable; ``y_n + h k1`` (linearly implicit Euler) is the embedded first-order
-solution, so the local error estimate is ``h (k1 + k2) / 2``. The step is accepted when the
-root-mean-square of ``error / (atol + rtol |y|)`` is at most 1, and the next one scaled by
-``0.9 / sqrt(err)`` (between 0.2 and 5 times).
+with one matrix ``I - gamma h J`` for all stages; the slab equations' block structure reduces it to
+an m x m factorisation per step (:mod:`.slab_linear_system`). The step is accepted when the
+root-mean-square of ``error / (atol + rtol max(|y_n|, |y_{n+1}|))`` is at most 1, and the next one
+is scaled by ``0.9 err^(-1/q)`` (between 0.2 and 5 times; ``q`` = order of the embedded solution + 1).
 
-Why a compiled method instead of ``scipy.integrate.solve_ivp``: the rate-and-state slabs need ~100
+The method (:data:`TABLEAUX`):
+
+- ``RODAS4`` (Hairer & Wanner 1996, Sec. VI.4, the coefficients of their code RODAS): 6 stages,
+  order 4 with an embedded order 3, L-stable and stiffly accurate, ``gamma = 1/4``; the error is
+  the last stage ``u_6``.
+
+Why compiled methods instead of ``scipy.integrate.solve_ivp``: the rate-and-state slabs need ~100
 steps per slip and ~500 slips per run; scipy's Radau costs ~4 ms a step in Python (measured,
-docs/experiment-model-rate-state.md), this ~10 us.
+docs/experiment-model-rate-state.md), these a few microseconds.
 """
+
+import dataclasses
+import math
 
 import numpy as np
 
 from ...numba_options import njit
-from .slab_equations import jacobian, rhs
+from .slab_equations import rhs_into
+from .slab_linear_system import factorize, new_factors, solve
 
-__all__ = ["ros2"]
-
-GAMMA = 1.0 + 1.0 / np.sqrt(2.0)
-
+__all__ = ["Tableau", "TABLEAUX", "FIRST_STEP", "step", "integrate"]
 
 #: First trial step of an integration [s].
 FIRST_STEP = 1e-6
 
 
+@dataclasses.dataclass(frozen=True)
+class Tableau:
+    """Coefficients of a Rosenbrock method in Hairer & Wanner's form (module docstring).
+
+    Attributes
+    ----------
+    gamma : float
+    alpha, Gamma : numpy.ndarray
+        Strictly lower triangular, float64 [s, s].
+    weights, error_weights : numpy.ndarray
+        ``m`` and ``e``, float64 [s].
+    order : int
+        Order of the method.
+    error_order : int
+        ``q``: the local error estimate is ``O(h^q)``.
+    """
+
+    gamma: float
+    alpha: np.ndarray
+    Gamma: np.ndarray
+    weights: np.ndarray
+    error_weights: np.ndarray
+    order: int
+    error_order: int
+
+    def arrays(self):
+        """The arguments of :func:`step` and :func:`integrate` that describe the method."""
+        return self.gamma, self.alpha, self.Gamma, self.weights, self.error_weights, 1.0 / self.error_order
+
+
+def _rodas4():
+    a5 = [1.221224509226641, 6.019134481288629, 12.53708332932087, -0.6878860361058950]
+    alpha = np.zeros((6, 6))
+    alpha[1, 0] = 1.544
+    alpha[2, :2] = [0.9466785280815826, 0.2557011698983284]
+    alpha[3, :3] = [3.314825187068521, 2.896124015972201, 0.9986419139977817]
+    alpha[4, :4] = a5
+    alpha[5, :5] = a5 + [1.0]              # stiffly accurate: stage 6 at the embedded solution
+    Gamma = np.zeros((6, 6))
+    Gamma[1, 0] = -5.6688
+    Gamma[2, :2] = [-2.430093356833875, -0.2063599157091915]
+    Gamma[3, :3] = [-0.1073529058151375, -9.594562251023355, -20.47028614809616]
+    Gamma[4, :4] = [7.496443313967647, -10.24680431464352, -33.99990352819905, 11.70890893206160]
+    Gamma[5, :5] = [8.083246795921522, -7.981132988064893, -31.52159432874371, 16.31930543123136,
+                    -6.058818238834054]
+    return Tableau(gamma=0.25, alpha=alpha, Gamma=Gamma, weights=np.array(a5 + [1.0, 1.0]),
+                   error_weights=np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1.0]), order=4, error_order=4)
+
+
+#: The compiled methods by name.
+TABLEAUX = {"RODAS4": _rodas4()}
+
+
 @njit
-def ros2(y0, t0, h0, t_pause, t_end, args, rtol, atol):
-    """Integrate ``dy/dt = rhs(y, *args)`` (:func:`.slab_equations.rhs`) from ``t0`` towards ``t_end``,
-    returning after the first accepted step at or beyond ``t_pause``.
+def _add_scaled(out, scale, x):
+    """``out += scale x`` without a temporary array."""
+    for i in range(out.size):
+        out[i] += scale * x[i]
+
+
+@njit
+def step(y, fy, h, gamma, alpha, Gamma, weights, error_weights, stages, y_new, error, work, factors, args):
+    """One Rosenbrock step of size ``h`` from ``y`` (with ``fy = f(y)``): writes ``y_new`` and the
+    local ``error`` (both float64 [n]); ``stages`` float64 [s, n] and ``work`` float64 [2, n] are
+    scratch, ``factors`` from :func:`.slab_linear_system.new_factors`; ``args`` those of
+    :func:`.slab_equations.rhs` after ``y``; returns None."""
+    n, s = y.size, weights.size
+    c = gamma * h
+    factorize(y, c, factors, *args)
+    point, right = work[0], work[1]
+    for i in range(s):
+        if i == 0:
+            right[:] = fy
+        else:
+            point[:] = y
+            for j in range(i):
+                if alpha[i, j] != 0.0:
+                    _add_scaled(point, alpha[i, j], stages[j])
+            rhs_into(point, right, *args)
+        right *= c
+        for j in range(i):
+            if Gamma[i, j] != 0.0:
+                _add_scaled(right, gamma * Gamma[i, j], stages[j])
+        solve(right, stages[i], c, factors, *args)
+    y_new[:] = y
+    error[:] = 0.0
+    for i in range(s):
+        if weights[i] != 0.0:
+            _add_scaled(y_new, weights[i], stages[i])
+        if error_weights[i] != 0.0:
+            _add_scaled(error, error_weights[i], stages[i])
+    return None
+
+
+@njit
+def integrate(y0, t0, h0, t_pause, t_end, args, rtol, atol, method):
+    """Integrate ``dy/dt = rhs(y, *args)`` (:func:`.slab_equations.rhs`) from ``t0`` towards ``t_end``
+    with the Rosenbrock ``method``, returning after the first accepted step at or beyond ``t_pause``.
+
+    Step control: module docstring, with Gustafsson's predictive controller (Hairer & Wanner 1996,
+    Sec. IV.8, as in their RODAS: after an accepted step the next one is the smaller of the classical
+    and the predicted size; after a rejection the step does not grow).
 
     Only ``t_end`` cuts a step short; ``t_pause`` does not, so that integrating in pieces (each call
     starting from the last state, time and next step size of the previous one) accepts exactly the
@@ -48,9 +153,9 @@ def ros2(y0, t0, h0, t_pause, t_end, args, rtol, atol):
         State at ``t0``, float64 [n].
     t0 : float
         Start time.
-    h0 : float
-        First trial step (> 0; :data:`FIRST_STEP` for a new integration, else the ``h`` returned
-        by the previous piece).
+    h0 : tuple
+        ``(h, h_accepted, norm_accepted)``: first trial step (> 0), size and error norm of the last
+        accepted step (0 and 1 for a new integration; else the ``h0`` returned by the previous piece).
     t_pause : float
         Return once an accepted step reaches it (``t0 < t_pause <= t_end``).
     t_end : float
@@ -60,6 +165,8 @@ def ros2(y0, t0, h0, t_pause, t_end, args, rtol, atol):
     rtol : float
     atol : numpy.ndarray
         Relative tolerance, and absolute tolerance per component [n].
+    method : tuple
+        :meth:`Tableau.arrays` of the method.
 
     Returns
     -------
@@ -71,42 +178,55 @@ def ros2(y0, t0, h0, t_pause, t_end, args, rtol, atol):
         ``rhs`` at those states, float64 [n_steps + 1, n].
     ok : bool
         False if the step size underflowed (the arrays end at the last accepted step).
-    h : float
-        Trial size of the next step.
+    h0 : tuple
+        ``(h, h_accepted, norm_accepted)`` for the next piece.
     """
     n = y0.size
     capacity = 1024
     ts = np.empty(capacity)
     ys = np.empty((capacity, n))
     fs = np.empty((capacity, n))
-    y = y0.copy()
-    fy = rhs(y, *args)
+    gamma, alpha, Gamma, weights, error_weights, exponent = method
+    stages = np.empty((weights.size, n))
+    work = np.empty((2, n))
+    factors = new_factors((n - 1) // 3)
+    y, fy, y_new, error = y0.copy(), np.empty(n), np.empty(n), np.empty(n)
+    rhs_into(y, fy, *args)
     t = t0
     ts[0], ys[0], fs[0] = t, y, fy
-    count = 1
-    h = min(h0, t_end - t0)
-    identity = np.eye(n)
+    count, rejected = 1, False
+    h, h_accepted, norm_accepted = h0
+    h = min(h, t_end - t0)
     while t < t_pause:
         if h < 1e-14 * max(1.0, t):
-            return ts[:count], ys[:count], fs[:count], False, h
+            return ts[:count], ys[:count], fs[:count], False, (h, h_accepted, norm_accepted)
         h = min(h, t_end - t)
-        J = jacobian(y, *args)
-        matrix = identity - GAMMA * h * J
-        k1 = np.linalg.solve(matrix, fy)
-        k2 = np.linalg.solve(matrix, rhs(y + h * k1, *args) - 2.0 * k1)
-        y_new = y + h * (1.5 * k1 + 0.5 * k2)
-        scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
-        error = np.sqrt(np.mean((0.5 * h * (k1 + k2) / scale) ** 2))
-        if not np.isfinite(error):
+        step(y, fy, h, gamma, alpha, Gamma, weights, error_weights, stages, y_new, error, work, factors, args)
+        total = 0.0
+        for i in range(n):
+            scaled = error[i] / (atol[i] + rtol * max(abs(y[i]), abs(y_new[i])))
+            total += scaled * scaled
+        norm = math.sqrt(total / n)
+        if not math.isfinite(norm):
             h *= 0.2
+            rejected = True
             continue
-        factor = min(5.0, max(0.2, 0.9 / np.sqrt(max(error, 1e-12))))
-        if error > 1.0:
+        norm = max(norm, 1e-12)
+        factor = min(5.0, max(0.2, 0.9 * norm ** -exponent))
+        if norm > 1.0:
             h *= min(factor, 0.9)
+            rejected = True
             continue
+        if h_accepted > 0.0:               # Gustafsson's prediction
+            predicted = 0.9 * h / h_accepted * (norm_accepted / (norm * norm)) ** exponent
+            factor = min(factor, max(0.2, predicted))
+        if rejected:
+            factor = min(factor, 1.0)
+        rejected = False
+        h_accepted, norm_accepted = h, max(norm, 1e-2)
         t = t + h if t_end - t > h else t_end
-        y = y_new
-        fy = rhs(y, *args)
+        y[:] = y_new
+        rhs_into(y, fy, *args)
         if count == capacity:
             capacity *= 2
             ts_new, ys_new, fs_new = np.empty(capacity), np.empty((capacity, n)), np.empty((capacity, n))
@@ -115,4 +235,4 @@ def ros2(y0, t0, h0, t_pause, t_end, args, rtol, atol):
         ts[count], ys[count], fs[count] = t, y, fy
         count += 1
         h *= factor
-    return ts[:count], ys[:count], fs[:count], True, h
+    return ts[:count], ys[:count], fs[:count], True, (h, h_accepted, norm_accepted)

@@ -17,9 +17,9 @@ State vector ``y = [R_S, V_S, psi_S, gamma]`` (3 m + 1 values, :mod:`.slab_equat
 [mm], slip rates [mm/s], ``psi = ln(V0 theta / D_c)``, lever rotation [rad]. The system is very
 stiff while the interfaces stick (the friction's stiffness ``N a / V`` with ``V`` down to nm/s
 gives rates ~1e12 /s) and fast during a slip (ms), so it is integrated with an implicit method
-with the analytic Jacobian: the compiled L-stable Rosenbrock method :mod:`.rosenbrock` (default),
-or ``scipy.integrate.solve_ivp``'s Radau, BDF, LSODA (same results, ~100 times slower a step in
-Python); an explicit method would need time steps below 1e-12 s.
+with the analytic Jacobian: the compiled L-stable Rosenbrock method RODAS4 of :mod:`.rosenbrock`
+(default), or ``scipy.integrate.solve_ivp``'s Radau, BDF, LSODA (same results, ~1000 times slower a
+step in Python); an explicit method would need time steps below 1e-12 s.
 
 Units: lengths [mm], forces [N], masses [kg] (accelerations ``1000 F / M`` [mm/s^2]), time [s].
 """
@@ -36,10 +36,11 @@ from .slab_equations import friction as _friction, jacobian as _jacobian, rhs as
 
 __all__ = ["SlabDynamics", "METHODS", "DEFAULT_METHOD"]
 
-#: Implicit methods: the numba-compiled Rosenbrock method, and those of scipy.integrate.solve_ivp.
-METHODS = ("ROS2", "Radau", "BDF", "LSODA")
-#: The method of the solver (docs/experiment-model-rate-state.md: 100 times faster than Radau per step).
-DEFAULT_METHOD = "ROS2"
+#: Implicit methods: the numba-compiled Rosenbrock methods, and those of scipy.integrate.solve_ivp.
+METHODS = (*rosenbrock.TABLEAUX, "Radau", "BDF", "LSODA")
+#: The method of the solver (docs/experiment-model-rate-state.md: the fewest steps, ~1000 times cheaper
+#: per step than Radau).
+DEFAULT_METHOD = "RODAS4"
 #: mm/s^2 per N/kg.
 MM_PER_M = 1000.0
 #: The compiled integration runs in this many pieces of equal simulated time, with a progress
@@ -102,26 +103,30 @@ class SlabDynamics:
         difference = np.linalg.inv(lower)               # V = D u
         reaction = np.eye(m) - np.eye(m, k=1)           # friction of interface k minus that of k + 1
         inverse_mass = MM_PER_M / self.masses
-        return drive, stiffness, difference * inverse_mass[None, :], reaction
+        accel = difference * inverse_mass[None, :]      # D M^-1 [mm/s^2 per N]
+        return accel @ drive, accel @ stiffness, accel @ (self.apparatus.normal_force * reaction)
 
     def __post_init__(self):
-        drive, stiffness, accel, reaction = self._matrices()
+        drive, stiffness, coupling = self._matrices()
         s = self.interfaces
-        object.__setattr__(self, "_drive", drive)
-        object.__setattr__(self, "_stiffness", stiffness)
-        object.__setattr__(self, "_accel", accel)              # D M^-1 [mm/s^2 per N]
-        object.__setattr__(self, "_friction_matrix", self.apparatus.normal_force * reaction)
+        object.__setattr__(self, "_drive", drive)              # [mm/s^2 per rad]
+        object.__setattr__(self, "_stiffness", stiffness)      # [1/s^2]
+        object.__setattr__(self, "_coupling", coupling)        # [mm/s^2 per unit friction coefficient]
         for name in ("a", "b", "D_c", "mu0"):
             object.__setattr__(self, "_" + name, np.asarray(getattr(self.law, name), dtype=float)[s])
 
     def _arrays(self):
-        return (self._drive, self._stiffness, self._accel, self._friction_matrix, self._mu0, self._a, self._b,
-                self._D_c, float(self.law.V0))
+        return (self._drive, self._stiffness, self._coupling, self._mu0, self._a, self._b, self._D_c,
+                float(self.law.V0))
 
     def friction(self, V, psi):
-        """Friction coefficients of the slippable interfaces at slip rates ``V`` [mm/s] and states ``psi``, [m]."""
-        return _friction(np.asarray(V, dtype=float), np.asarray(psi, dtype=float), self._mu0, self._a, self._b,
-                         float(self.law.V0))
+        """Friction coefficients of the slippable interfaces at slip rates ``V`` [mm/s] and states ``psi``,
+        [..., m] (the shape of ``V``)."""
+        V, psi = np.broadcast_arrays(np.asarray(V, dtype=float), np.asarray(psi, dtype=float))
+        m = self._a.size
+        mu = _friction(np.ascontiguousarray(V.reshape(-1, m)), np.ascontiguousarray(psi.reshape(-1, m)), self._mu0,
+                       self._a, self._b, float(self.law.V0))
+        return mu.reshape(V.shape)
 
     def rhs(self, y, rate):
         """dy/dt of the state ``y = [R, V, psi, gamma]`` [3 m + 1] with the lever turning at ``rate`` [1/s]."""
@@ -151,11 +156,19 @@ class SlabDynamics:
         R0 = shifted.relaxed_slips(target)
         return R0, np.concatenate([R0[self.interfaces], V, psi, [gamma_start]])
 
-    def tolerances(self, R=1e-6, V=1e-9, psi=1e-4):
-        """Absolute tolerances of the state components: slips ``R`` [mm], slip rates ``V`` [mm/s], states
-        ``psi`` (and 1e-12 rad for gamma), float64 [3 m + 1]."""
+    def tolerances(self, rtol, R=1e-2, V=1e-11, psi=1.0):
+        """Absolute tolerances of the state components, proportional to the relative tolerance ``rtol``
+        (so that ``rtol`` alone sets how tight an integration is): ``rtol`` times the scales of the slips
+        ``R`` [mm], slip rates ``V`` [mm/s], states ``psi`` (and 1e-8 rad for gamma), float64 [3 m + 1].
+        At ``rtol`` = 1e-4: 1e-6 mm, 1e-15 mm/s, 1e-4 and 1e-12 rad.
+
+        The slip rates are held to their relative error down to 1e-11 mm/s because the friction
+        depends on their logarithm (``d mu = a dV / V``): a stuck interface creeps at 1e-11 to 1e-9
+        mm/s, and an absolute 1e-9 mm/s (the tolerance before issue 12's third session) let a step
+        carry it through zero, flipping its friction (step-size underflow of RODAS4 at t = 334 s in
+        the stack n = 3, seed 1)."""
         m = self.interfaces.size
-        return np.concatenate([np.full(m, R), np.full(m, V), np.full(m, psi), [1e-12]])
+        return rtol * np.concatenate([np.full(m, R), np.full(m, V), np.full(m, psi), [1e-8]])
 
     def integrate(self, y0, duration, rate, *, method=DEFAULT_METHOD, rtol=1e-4, atol=None):
         """Integrate ``duration`` [s] from ``y0`` with the lever turning at ``rate`` [1/s].
@@ -168,20 +181,20 @@ class SlabDynamics:
             [s] (> 0).
         rate : float
             d gamma / dt [1/s] (0: a hold).
-        method : {"ROS2", "Radau", "BDF", "LSODA"}
-            "ROS2": the numba-compiled L-stable Rosenbrock method :func:`rosenbrock.ros2`; the others:
-            ``scipy.integrate.solve_ivp`` (:data:`METHODS`).
+        method : {"RODAS4", "Radau", "BDF", "LSODA"}
+            "RODAS4": the numba-compiled L-stable Rosenbrock method :func:`rosenbrock.integrate`; the
+            others: ``scipy.integrate.solve_ivp`` (:data:`METHODS`).
         rtol : float
             Relative tolerance of the step control.
         atol : numpy.ndarray, optional
-            Absolute tolerances [3 m + 1]; default :meth:`tolerances`.
+            Absolute tolerances [3 m + 1]; default :meth:`tolerances` of ``rtol``.
 
         Notes
         -----
         Progress (seconds simulated of ``duration``, rate, time left, steps so far) goes to stderr
         through :mod:`stickslip.progress`: a live bar on a terminal, a line every interval in a job's
-        log. "ROS2" integrates in :data:`PROGRESS_PIECES` pieces for that, with the same steps (and
-        results, bit for bit) as in one piece.
+        log. The compiled methods integrate in :data:`PROGRESS_PIECES` pieces for that, with the same
+        steps (and results, bit for bit) as in one piece.
 
         Returns
         -------
@@ -200,11 +213,11 @@ class SlabDynamics:
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
         y0 = np.ascontiguousarray(y0, dtype=float)
-        atol = self.tolerances() if atol is None else np.ascontiguousarray(atol, dtype=float)
+        atol = self.tolerances(rtol) if atol is None else np.ascontiguousarray(atol, dtype=float)
         duration = float(duration)
         with _SimulatedTime(duration) as clock:
-            if method == "ROS2":
-                return self._integrate_ros2(y0, duration, float(rate), rtol, atol, clock)
+            if method in rosenbrock.TABLEAUX:
+                return self._integrate_compiled(method, y0, duration, float(rate), rtol, atol, clock)
 
             def rhs(t, y):
                 clock.at(t, None)
@@ -219,17 +232,19 @@ class SlabDynamics:
             y = solution.y.T
             return solution.t, y, np.array([self.rhs(row, rate) for row in y])
 
-    def _integrate_ros2(self, y0, duration, rate, rtol, atol, clock):
-        """:func:`rosenbrock.ros2` in :data:`PROGRESS_PIECES` pieces of simulated time (the same steps as
-        in one piece), reporting to ``clock`` after each."""
+    def _integrate_compiled(self, name, y0, duration, rate, rtol, atol, clock):
+        """:func:`rosenbrock.integrate` with the method ``name`` in
+        :data:`PROGRESS_PIECES` pieces of simulated time (the same steps as in one piece), reporting to
+        ``clock`` after each."""
         args = (rate, *self._arrays())
-        t_now, y_now, h, steps = 0.0, y0, rosenbrock.FIRST_STEP, 0
+        method = rosenbrock.TABLEAUX[name].arrays()
+        t_now, y_now, h, steps = 0.0, y0, (rosenbrock.FIRST_STEP, 0.0, 1.0), 0
         ts, ys, fs = [], [], []
         for k in range(1, PROGRESS_PIECES + 1):
             t_pause = duration * k / PROGRESS_PIECES
             if t_now >= t_pause:
                 continue
-            t, y, dydt, ok, h = rosenbrock.ros2(y_now, t_now, h, t_pause, duration, args, rtol, atol)
+            t, y, dydt, ok, h = rosenbrock.integrate(y_now, t_now, h, t_pause, duration, args, rtol, atol, method)
             first = 1 if ts else 0          # a later piece starts where the previous one ended
             ts.append(t[first:])
             ys.append(y[first:])

@@ -4,36 +4,79 @@ State ``y = [R, V, psi, gamma]`` (3 m + 1 values for m slippable interfaces): sl
 rates [mm/s], ``psi = ln(V0 theta/D_c)``, lever rotation [rad]::
 
     dR/dt = V
-    dV/dt = A (drive gamma - stiffness R - friction_matrix mu)
+    dV/dt = drive gamma - stiffness R - coupling mu
     dpsi/dt = (V0 exp(-psi) - |V|) / D_c
     dgamma/dt = rate
 
-``A = D M^-1`` turns the net forces on the bodies [N] into relative accelerations of the
-interfaces [mm/s^2] (see :class:`.slab_dynamics.SlabDynamics`). The friction is the regularised
-Dieterich–Ruina law (Rice & Ben-Zion 1996), odd in ``V`` so that an interface may also slide
-backwards::
+``drive``, ``stiffness`` and ``coupling`` are the spring and friction forces on the bodies turned
+into relative accelerations of the interfaces [mm/s^2] (``A = D M^-1`` times the force matrices, see
+:class:`.slab_dynamics.SlabDynamics`). The friction is the regularised Dieterich–Ruina law (Rice &
+Ben-Zion 1996), odd in ``V`` so that an interface may also slide backwards::
 
     mu = a asinh(V / (2 V0) exp((mu0 + b psi) / a))
 
 which equals ``mu0 + a ln(V/V0) + b psi`` to within ``exp(-2 (mu0 + b psi)/a)`` (< 1e-20 here)
 for ``V > 0``.
+
+The arguments after ``y`` are the same for every function here (``rate, drive, stiffness, coupling,
+mu0, a, b, D_c, V0``, see :func:`rhs`), so that the integrator passes one tuple to all of them.
 """
+
+import math
 
 import numpy as np
 
 from ...numba_options import njit
 
-__all__ = ["rhs", "jacobian", "friction"]
+__all__ = ["rhs", "rhs_into", "jacobian", "friction", "friction_slopes"]
+
+
+@njit
+def _friction(V, psi, mu0, a, b, V0):
+    """Friction coefficient of one interface (scalars)."""
+    return a * math.asinh(V / (2.0 * V0) * math.exp((mu0 + b * psi) / a))
+
+
+@njit
+def friction_slopes(V, psi, mu0, a, b, V0):
+    """``d mu / dV`` [s/mm] and ``d mu / d psi`` of one interface (scalars)."""
+    width = 2.0 * V0 * math.exp(-(mu0 + b * psi) / a)    # mu = a asinh(V / width)
+    root = math.sqrt(width * width + V * V)
+    return a / root, b * V / root
 
 
 @njit
 def friction(V, psi, mu0, a, b, V0):
-    """Regularised friction coefficient, shape of ``V`` [m]."""
-    return a * np.arcsinh(V / (2.0 * V0) * np.exp((mu0 + b * psi) / a))
+    """Regularised friction coefficients at slip rates ``V`` [mm/s] and states ``psi``, both
+    float64 [k, m] (one row per time, one column per interface), with the parameters ``mu0, a, b``
+    [m] and ``V0``; returns [k, m]."""
+    mu = np.empty(V.shape)
+    for row in range(V.shape[0]):
+        for k in range(V.shape[1]):
+            mu[row, k] = _friction(V[row, k], psi[row, k], mu0[k], a[k], b[k], V0)
+    return mu
 
 
 @njit
-def rhs(y, rate, drive, stiffness, accel, friction_matrix, mu0, a, b, D_c, V0):
+def rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0):
+    """dy/dt written into ``out`` (float64 [3 m + 1]; no allocation); arguments of :func:`rhs`."""
+    m = mu0.size
+    for k in range(m):                     # out[2m:3m] holds mu until the last loop
+        out[2 * m + k] = _friction(y[m + k], y[2 * m + k], mu0[k], a[k], b[k], V0)
+    gamma = y[3 * m]
+    for i in range(m):
+        acceleration = drive[i] * gamma
+        for k in range(m):
+            acceleration -= stiffness[i, k] * y[k] + coupling[i, k] * out[2 * m + k]
+        out[m + i] = acceleration
+    for i in range(m):
+        out[i] = y[m + i]
+        out[2 * m + i] = (V0 * math.exp(-y[2 * m + i]) - abs(y[m + i])) / D_c[i]
+    out[3 * m] = rate
+
+
+@njit
+def rhs(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0):
     """dy/dt, float64 [3 m + 1].
 
     Parameters
@@ -43,49 +86,34 @@ def rhs(y, rate, drive, stiffness, accel, friction_matrix, mu0, a, b, D_c, V0):
     rate : float
         d gamma/dt [1/s].
     drive : numpy.ndarray
-        Spring force per radian of lever rotation on every body [N], [m].
+        Relative accelerations of the interfaces per radian of lever rotation [mm/s^2], [m].
     stiffness : numpy.ndarray
-        Spring force per mm of slip [N/mm], [m, m].
-    accel : numpy.ndarray
-        ``A``: relative accelerations per body force [mm/s^2/N], [m, m].
-    friction_matrix : numpy.ndarray
-        Friction forces on the bodies per friction coefficient [N], [m, m].
+        Relative accelerations per mm of slip [1/s^2], [m, m].
+    coupling : numpy.ndarray
+        Relative accelerations per unit friction coefficient [mm/s^2], [m, m].
     mu0, a, b, D_c : numpy.ndarray
         Rate-and-state parameters of the slippable interfaces, [m] (D_c [mm]).
     V0 : float
         Reference slip rate [mm/s].
     """
-    m = mu0.size
-    R, V, psi, gamma = y[:m], y[m:2 * m], y[2 * m:3 * m], y[3 * m]
-    force = drive * gamma - stiffness @ R - friction_matrix @ friction(V, psi, mu0, a, b, V0)
-    out = np.empty(3 * m + 1)
-    out[:m] = V
-    out[m:2 * m] = accel @ force
-    out[2 * m:3 * m] = (V0 * np.exp(-psi) - np.abs(V)) / D_c
-    out[3 * m] = rate
+    out = np.empty(y.size)
+    rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0)
     return out
 
 
 @njit
-def jacobian(y, rate, drive, stiffness, accel, friction_matrix, mu0, a, b, D_c, V0):
+def jacobian(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0):
     """d(dy/dt)/dy, float64 [3 m + 1, 3 m + 1]; arguments of :func:`rhs`."""
     m = mu0.size
-    V, psi = y[m:2 * m], y[2 * m:3 * m]
-    width = 2.0 * V0 * np.exp(-(mu0 + b * psi) / a)    # mu = a asinh(V / width)
-    root = np.sqrt(width * width + V * V)
-    by_V = a / root                                     # d mu / dV
-    by_psi = b * V / root                               # d mu / d psi
-    coupling = accel @ friction_matrix
-    by_R = accel @ stiffness
-    by_gamma = accel @ drive
     J = np.zeros((3 * m + 1, 3 * m + 1))
-    for i in range(m):
-        J[i, m + i] = 1.0
-        for k in range(m):
-            J[m + i, k] = -by_R[i, k]
-            J[m + i, m + k] = -coupling[i, k] * by_V[k]
-            J[m + i, 2 * m + k] = -coupling[i, k] * by_psi[k]
-        J[m + i, 3 * m] = by_gamma[i]
-        J[2 * m + i, m + i] = -np.sign(V[i]) / D_c[i]
-        J[2 * m + i, 2 * m + i] = -V0 / D_c[i] * np.exp(-psi[i])
+    for k in range(m):
+        by_V, by_psi = friction_slopes(y[m + k], y[2 * m + k], mu0[k], a[k], b[k], V0)
+        for i in range(m):
+            J[m + i, k] = -stiffness[i, k]
+            J[m + i, m + k] = -coupling[i, k] * by_V
+            J[m + i, 2 * m + k] = -coupling[i, k] * by_psi
+        J[k, m + k] = 1.0
+        J[m + k, 3 * m] = drive[k]
+        J[2 * m + k, m + k] = -np.sign(y[m + k]) / D_c[k]
+        J[2 * m + k, 2 * m + k] = -V0 / D_c[k] * math.exp(-y[2 * m + k])
     return J

@@ -80,11 +80,12 @@ def slip_intervals(apparatus, t, R_at, V, theta, slip_velocity):
         previous_end = np.concatenate([[0.0], ends[:-1]])
         creep = R_on[:, i] - R_at(previous_end)[:, i]
         T = np.concatenate([[np.nan], np.diff(onsets)])
+        theta_on = np.interp(onsets, t, theta[:, i])
         for k in range(onsets.size):
             dR = R_off[k, i] - R_on[k, i]
             rows.append((onsets[k], ends[k], i + 1, dR, dR * force_per_slip[i], mu_on[k] - mu_off[k], mu_on[k],
                          mu_off[k], T[k], T[k] if k else onsets[k], creep[k],
-                         float(V[first[k]:last[k] + 1, i].max()), float(np.interp(onsets[k], t, theta[:, i]))))
+                         float(V[first[k]:last[k] + 1, i].max()), float(theta_on[k])))
     columns = [c for c in TRUTH_COLUMNS if c not in ("event", "multi")]
     slips = pd.DataFrame(rows, columns=columns).sort_values(["t_start", "a"], kind="stable").reset_index(drop=True)
     # Events: chains of overlapping intervals.
