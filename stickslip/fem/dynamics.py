@@ -32,22 +32,33 @@ def _predict(lo, hi, dt, u, v, a):
 
 
 @njit
+def _verlet_velocity(dt, minv, d, f, v_n, a_n):
+    # steps 2-4 of one DOF: velocity and acceleration at the new time
+    v = v_n + dt * a_n
+    a = -(f + d * v) * minv
+    v = v_n + 0.5 * dt * (a_n + a)
+    a = -(f + d * v) * minv
+    v = v_n + 0.5 * dt * (a_n + a)
+    a = -(f + d * v) * minv
+    return v, a
+
+
+@njit
 def _correct(lo, hi, dt, mass_inv, damping, f, v, a):
-    mm, dd, ff, vv, aa = mass_inv[lo:hi], damping[lo:hi], f[lo:hi], v[lo:hi], a[lo:hi]
-    for i in range(hi - lo):
-        minv = mm[i]
-        d = dd[i]
-        fi = ff[i]
-        v_n = vv[i]
-        a_n = aa[i]
-        vi = v_n + dt * a_n
-        ai = -(fi + d * vi) * minv
-        vi = v_n + 0.5 * dt * (a_n + ai)
-        ai = -(fi + d * vi) * minv
-        vi = v_n + 0.5 * dt * (a_n + ai)
-        ai = -(fi + d * vi) * minv
-        vv[i] = vi
-        aa[i] = ai
+    # A DOF's update is one chain of ~20 dependent operations, so the loop is bound by their latency:
+    # the two halves of the range are interleaved (two independent chains per iteration; each DOF's
+    # operations unchanged, same bits). Measured 101 -> 88 us at N = 1458, 2 plates.
+    h = (hi - lo) // 2
+    mid = lo + h
+    mm, dd, ff, vv, aa = mass_inv[lo:mid], damping[lo:mid], f[lo:mid], v[lo:mid], a[lo:mid]
+    mm2, dd2, ff2, vv2, aa2 = mass_inv[mid:hi], damping[mid:hi], f[mid:hi], v[mid:hi], a[mid:hi]
+    for i in range(h):
+        v1, a1 = _verlet_velocity(dt, mm[i], dd[i], ff[i], vv[i], aa[i])
+        v2, a2 = _verlet_velocity(dt, mm2[i], dd2[i], ff2[i], vv2[i], aa2[i])
+        vv[i], aa[i] = v1, a1
+        vv2[i], aa2[i] = v2, a2
+    for i in range(mid + h, hi):  # odd length: the last DOF
+        v[i], a[i] = _verlet_velocity(dt, mass_inv[i], damping[i], f[i], v[i], a[i])
 
 
 # Parallel variants over blocks of DOFs (plain arrays: numba loses writes to named-tuple fields in prange).
