@@ -32,9 +32,11 @@ def test_density_is_normalised_on_linear_and_logarithmic_bins():
 
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
-    """A small virtual study: stacks n = 1..5 and interfaces 1..4 driven alone, analysed."""
+    """A small virtual study on the default study's virtual experiment (``rate-state-lever``; the
+    workflow smoke test draws every figure from ``lever`` runs): stacks n = 1..5 and interfaces 1..4
+    driven alone, analysed."""
     root = tmp_path_factory.mktemp("study")
-    solver, analysis = registry.get("solver", "lever"), registry.get("analysis", "experiment-events")
+    solver, analysis = registry.get("solver", "rate-state-lever"), registry.get("analysis", "experiment-events")
     runs = [{"n": n, "seed": n} for n in range(1, 6)]
     runs += [{"protocol": "individual", "a": a, "seed": 10 + a} for a in range(1, 5)]
     inputs = {experimental_data.EVENTS: []}
