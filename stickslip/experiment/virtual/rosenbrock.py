@@ -12,8 +12,11 @@ an m x m factorisation per step (:mod:`.slab_linear_system`). The step is accept
 root-mean-square of ``error / (atol + rtol max(|y_n|, |y_{n+1}|))`` is at most 1, and the next one
 is scaled by ``0.9 err^(-1/q)`` (between 0.2 and 5 times; ``q`` = order of the embedded solution + 1).
 
-The method (:data:`TABLEAUX`):
+The methods (:data:`TABLEAUX`):
 
+- ``ROS2`` (Verwer, Spee, Blom & Hundsdorfer 1999, SIAM J. Sci. Comput. 20, 1456): 2 stages, order 2,
+  L-stable, ``gamma = 1 + 1/sqrt(2)``; embedded: the linearly implicit Euler step (order 1). The
+  first session's method; now RODAS4's fallback (:meth:`.slab_dynamics.SlabDynamics.integrate`).
 - ``RODAS4`` (Hairer & Wanner 1996, Sec. VI.4, the coefficients of their code RODAS): 6 stages,
   order 4 with an embedded order 3, L-stable and stiffly accurate, ``gamma = 1/4``; the error is
   the last stage ``u_6``.
@@ -68,6 +71,16 @@ class Tableau:
         return self.gamma, self.alpha, self.Gamma, self.weights, self.error_weights, 1.0 / self.error_order
 
 
+def _ros2():
+    gamma = 1.0 + 1.0 / math.sqrt(2.0)
+    # (I - gamma h J) k1 = f(y), (I - gamma h J) k2 = f(y + h k1) - 2 k1, y1 = y + h (3 k1 + k2) / 2,
+    # error h (k1 + k2) / 2; with u_i = gamma h k_i:
+    return Tableau(gamma=gamma, alpha=np.array([[0.0, 0.0], [1.0 / gamma, 0.0]]),
+                   Gamma=np.array([[0.0, 0.0], [-2.0 / gamma, 0.0]]),
+                   weights=np.array([1.5, 0.5]) / gamma, error_weights=np.array([0.5, 0.5]) / gamma,
+                   order=2, error_order=2)
+
+
 def _rodas4():
     a5 = [1.221224509226641, 6.019134481288629, 12.53708332932087, -0.6878860361058950]
     alpha = np.zeros((6, 6))
@@ -88,7 +101,7 @@ def _rodas4():
 
 
 #: The compiled methods by name.
-TABLEAUX = {"RODAS4": _rodas4()}
+TABLEAUX = {"RODAS4": _rodas4(), "ROS2": _ros2()}
 
 
 @njit
