@@ -16,15 +16,59 @@ Notes
 -----
 ``fastmath`` stays off: reordering floating-point operations would break the
 bit-identical reproducibility promised for the same parameters and seed.
+
+numba's on-disk cache is not safe for processes that add entries to one
+function's cache at the same time (Snakemake jobs sharing one cache directory):
+each reads the index, picks the first free data-file number and writes both, so
+two processes compiling different signatures can pair one signature's index
+entry with the other's machine code, and every later process that loads it
+crashes (seen: segmentation faults of the ``front-dynamics`` jobs of a fresh
+default study). :func:`serialise_cache_writes`, applied on import, makes each
+index update and its data file one critical section under an exclusive lock.
 """
 
+import fcntl
 import os
 
 import numba
+from numba.core import caching
 
 CACHE = os.environ.get("STICKSLIP_NUMBA_CACHE", "1") != "0"
 
 NJIT_OPTIONS = {"cache": CACHE, "nogil": True, "fastmath": False, "error_model": "numpy"}
+
+
+def cache_lock_path(cache_file):
+    """The lock file of one function's on-disk cache (beside its index ``*.nbi``)."""
+    return cache_file._index_path + ".lock"
+
+
+def serialise_cache_writes():
+    """Make numba's cache writes (index and data file of one entry) exclusive across processes.
+
+    Wraps ``numba.core.caching.IndexDataCacheFile.save`` (numba pinned in environment.txt) in
+    an ``fcntl.flock`` on :func:`cache_lock_path`: the index is re-read, extended and
+    written, and the data file written, while no other process can do the same for that
+    function. Idempotent.
+    """
+    save = caching.IndexDataCacheFile.save
+    if getattr(save, "serialised", False):
+        return
+
+    def locked_save(self, key, data):
+        os.makedirs(self._cache_path, exist_ok=True)
+        with open(cache_lock_path(self), "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                save(self, key, data)
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    locked_save.serialised = True
+    caching.IndexDataCacheFile.save = locked_save
+
+
+serialise_cache_writes()
 
 
 def njit(*args, parallel=False, **kwargs):
