@@ -20,11 +20,12 @@ bit-identical reproducibility promised for the same parameters and seed.
 numba's on-disk cache is not safe for processes that add entries to one
 function's cache at the same time (Snakemake jobs sharing one cache directory):
 each reads the index, picks the first free data-file number and writes both, so
-two processes compiling different signatures can pair one signature's index
-entry with the other's machine code, and every later process that loads it
-crashes (seen: segmentation faults of the ``front-dynamics`` jobs of a fresh
-default study). :func:`serialise_cache_writes`, applied on import, makes each
-index update and its data file one critical section under an exclusive lock.
+two processes compiling different signatures can give both the same data-file
+number, pairing one signature's index entry with the other's machine code.
+:func:`serialise_cache_writes`, applied on import, makes each index update and
+its data file one critical section under an exclusive lock. (It does not cure
+the segmentation faults seen in some fresh default studies' ``front-dynamics``
+jobs, whose cache indexes hold no such pairing: see docs/workflow.md.)
 """
 
 import fcntl
