@@ -17,15 +17,22 @@ Notes
 ``fastmath`` stays off: reordering floating-point operations would break the
 bit-identical reproducibility promised for the same parameters and seed.
 
-numba's on-disk cache is not safe for processes that add entries to one
-function's cache at the same time (Snakemake jobs sharing one cache directory):
-each reads the index, picks the first free data-file number and writes both, so
-two processes compiling different signatures can give both the same data-file
-number, pairing one signature's index entry with the other's machine code.
-:func:`serialise_cache_writes`, applied on import, makes each index update and
-its data file one critical section under an exclusive lock. (It does not cure
-the segmentation faults seen in some fresh default studies' ``front-dynamics``
-jobs, whose cache indexes hold no such pairing: see docs/workflow.md.)
+numba's on-disk cache has two defects that hit Snakemake jobs sharing one cache
+directory; both are worked around here, on import:
+
+- Concurrent writers: each process reads a function's index, picks the first free
+  data-file number and writes both, so two processes compiling different
+  signatures can pair one signature's index entry with the other's machine code.
+  :func:`serialise_cache_writes` makes each index update and its data file one
+  critical section under an exclusive lock.
+- A cached caller of a ``parallel=True`` kernel can lose the hook that starts the
+  threading layer (numba issues #8578 and #9938): a caller compiled in a process
+  that loaded the parallel kernel from the cache is cached without it, and a later
+  process whose first kernel is that caller calls the threading layer's
+  unresolved symbols (address 0) and dies with SIGSEGV. This crashed the
+  ``front-dynamics`` jobs of fresh default studies (their first kernel is
+  ``compute_force``). :func:`start_threading_layer` starts the threading layer
+  before any kernel is loaded.
 """
 
 import fcntl
@@ -69,7 +76,23 @@ def serialise_cache_writes():
     caching.IndexDataCacheFile.save = locked_save
 
 
+def start_threading_layer():
+    """Start numba's threading layer, so that the symbols of parallel kernels resolve on a cache load.
+
+    Must run before the first cached kernel is loaded (here: on import of this module,
+    which every kernel module imports to get :func:`njit`). ``NUMBA_NUM_THREADS`` must be
+    set before, as :func:`stickslip.workflow_api.prepare_environment` does. Idempotent.
+
+    Returns
+    -------
+    int
+        The number of threads numba uses.
+    """
+    return numba.get_num_threads()  # launches the threading layer on the first call
+
+
 serialise_cache_writes()
+start_threading_layer()
 
 
 def njit(*args, parallel=False, **kwargs):
