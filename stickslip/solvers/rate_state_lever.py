@@ -27,6 +27,7 @@ from ..experiment.virtual.model import apparatus as apparatus_of, per_interface,
 from ..experiment.virtual.rate_state import RateStateLaw
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS, SlabDynamics
 from ..experiment.virtual.slip_intervals import slip_intervals
+from ..experiment.virtual.slip_path import PathProfiles
 from ..params import ParameterError, param, params_to_dict
 from .lever import LeverParams, check_protocol
 
@@ -59,6 +60,11 @@ _OWN = [
     ("V0", float, param(1e-3, "reference slip rate V0", unit="mm/s", exclusive_minimum=0)),
     ("disorder", float, param(0.05, "relative standard deviation of b and D_c drawn per interface and seed "
                                     "(quenched disorder; 0: none)", minimum=0)),
+    ("path_disorder", float, param(0.0, "relative standard deviation of mu0 along each interface's slip path "
+                                         "(heterogeneity of the surface, drawn per interface and seed; 0: none)",
+                                   minimum=0)),
+    ("path_correlation_length", float, param(0.025, "correlation length of mu0 along the slip path (the paper's "
+                                                    "asperity size)", unit="mm", minimum=0.001, maximum=1.0)),
     ("slab_mass", float, param(0.143, "mass of one slab (PMMA 10 x 150 x 80 mm)", unit="kg", exclusive_minimum=0)),
     ("load_mass", float, param(5.0, "dead weight on the top slab", unit="kg", minimum=0)),
     ("theta_start", float, param(0.01, "contact age of every interface at t = 0 (just slipped)", unit="s",
@@ -116,8 +122,11 @@ def simulate(params):
     """
     apparatus = apparatus_of(params)
     law = law_of(params)
-    dynamics = SlabDynamics(apparatus, law, params.slab_mass, params.load_mass)
+    path = (PathProfiles.draw(params.seed, params.n_slabs, params.path_disorder, params.path_correlation_length)
+            if params.path_disorder > 0 else None)
+    dynamics = SlabDynamics(apparatus, law, params.slab_mass, params.load_mass, path=path)
     R0, y0 = dynamics.initial_state(params.V_start, params.theta_start, params.gamma_start)
+    dynamics = dataclasses.replace(dynamics, path_origin=y0[:dynamics.interfaces.size])
     t, y, dydt = dynamics.integrate(y0, params.duration, apparatus.shear_rate, method=params.method,
                                     rtol=params.rtol)
     index, m = dynamics.interfaces, dynamics.interfaces.size

@@ -11,7 +11,7 @@ rate of interface ``s_l``) and obeys Newton's law::
 with ``S_k`` the spring forces on its driven slabs (:meth:`.apparatus.Apparatus.spring_forces`, ``K
 (j h gamma(t) - x_j)``) and ``N mu_k`` the friction of interface ``s_k``
 (:class:`.rate_state.RateStateLaw`; the same normal force ``N`` on every interface, as in the
-statics). In quasi-static equilibrium ``mu_k`` equals the apparatus's ``mu_i = sum_{j >= i} f_j / N``.
+statics), whose ``mu0`` may vary along the slip path (:mod:`.slip_path`). In quasi-static equilibrium ``mu_k`` equals the apparatus's ``mu_i = sum_{j >= i} f_j / N``.
 
 State vector ``y = [R_S, V_S, psi_S, gamma]`` (3 m + 1 values, :mod:`.slab_equations`): slips
 [mm], slip rates [mm/s], ``psi = ln(V0 theta / D_c)``, lever rotation [rad]. The system is very
@@ -33,6 +33,7 @@ from scipy.integrate import solve_ivp
 from ... import progress
 from . import rosenbrock
 from .slab_equations import friction as _friction, jacobian as _jacobian, rhs as _rhs
+from .slip_path import no_path
 
 __all__ = ["SlabDynamics", "METHODS", "DEFAULT_METHOD"]
 
@@ -69,12 +70,20 @@ class SlabDynamics:
         Mass of one slab [kg].
     load_mass : float
         Mass of the dead weight on the top slab [kg].
+    path : PathProfiles, optional
+        Heterogeneity of ``mu0`` along the slip path (:class:`.slip_path.PathProfiles`); None: none.
+    path_origin : numpy.ndarray, optional
+        Slips [mm] of the slippable interfaces at which the path starts (``delta = 0``), [m]; None: 0.
+        A run sets it to the slips of its initial state (:meth:`initial_state` takes the friction
+        there), with ``dataclasses.replace``.
     """
 
     apparatus: object
     law: object
     slab_mass: float
     load_mass: float
+    path: object = None
+    path_origin: object = None
 
     @property
     def interfaces(self):
@@ -122,18 +131,24 @@ class SlabDynamics:
         object.__setattr__(self, "_coupling", coupling)        # [mm/s^2 per unit friction coefficient]
         for name in ("a", "b", "D_c", "mu0"):
             object.__setattr__(self, "_" + name, np.asarray(getattr(self.law, name), dtype=float)[s])
+        origin = np.zeros(s.size) if self.path_origin is None else np.asarray(self.path_origin, dtype=float)
+        object.__setattr__(self, "_origin", origin)
+        object.__setattr__(self, "_path", no_path(s.size) if self.path is None else
+                           self.path.arguments(s, self._mu0, origin))
 
     def _arrays(self):
         return (self._drive, self._stiffness, self._coupling, self._mu0, self._a, self._b, self._D_c,
-                float(self.law.V0))
+                float(self.law.V0), self._path)
 
-    def friction(self, V, psi):
-        """Friction coefficients of the slippable interfaces at slip rates ``V`` [mm/s] and states ``psi``,
-        [..., m] (the shape of ``V``)."""
-        V, psi = np.broadcast_arrays(np.asarray(V, dtype=float), np.asarray(psi, dtype=float))
+    def friction(self, V, psi, R=None):
+        """Friction coefficients of the slippable interfaces at slip rates ``V`` [mm/s], states ``psi``
+        and slips ``R`` [mm] (None: at the start of the slip path), [..., m] (the shape of ``V``)."""
+        R = self._origin if R is None else R
+        R, V, psi = np.broadcast_arrays(np.asarray(R, dtype=float), np.asarray(V, dtype=float),
+                                        np.asarray(psi, dtype=float))
         m = self._a.size
-        mu = _friction(np.ascontiguousarray(V.reshape(-1, m)), np.ascontiguousarray(psi.reshape(-1, m)), self._mu0,
-                       self._a, self._b, float(self.law.V0))
+        rows = [np.ascontiguousarray(x.reshape(-1, m)) for x in (R, V, psi)]
+        mu = _friction(*rows, self._mu0, self._a, self._b, float(self.law.V0), self._path)
         return mu.reshape(V.shape)
 
     def rhs(self, y, rate):
@@ -147,7 +162,7 @@ class SlabDynamics:
     def initial_state(self, V_start, theta_start, gamma_start):
         """State at rest in equilibrium: slip rates ``V_start`` [mm/s] and contact ages ``theta_start`` [s]
         of the slippable interfaces, lever rotation ``gamma_start`` [rad], and the slips that make the
-        springs balance the friction.
+        springs balance the friction (that at the start of the slip path, ``delta = 0``).
 
         Returns
         -------
