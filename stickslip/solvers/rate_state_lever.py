@@ -4,7 +4,8 @@ The apparatus, protocols, sensors and file format of the ``lever`` solver
 (:mod:`stickslip.solvers.lever`), but every slippable interface obeys rate-and-state friction with
 the aging law (:mod:`stickslip.experiment.virtual.rate_state`) and the slabs move by Newton's law
 (:mod:`stickslip.experiment.virtual.slab_dynamics`): sticks, slips, creep and any simultaneous
-slip follow from the equations, nothing is scheduled. Model, defaults and their sources:
+slip follow from the equations, nothing is scheduled. Optionally (``path_disorder`` > 0) each interface's
+``mu0`` varies along its slip path (:mod:`stickslip.experiment.virtual.slip_path`). Model, defaults and their sources:
 docs/experiment-model-rate-state.md.
 
 Output: the experimental time-series file with the attributes ``params`` (JSON), ``seed``, ``solver``,
