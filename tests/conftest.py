@@ -103,6 +103,27 @@ def toy_results(tmp_path, toy_plugins, monkeypatch):
     return records
 
 
+#: The fem solver's reference case, the paper code's regression run (shared/reference/FixedLever_historic.h5):
+#: 350 increments.
+FEM_REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "drive": "fixed-lever", "nchunk": 200,
+                      "yield_strains": "stop"}
+
+
+@pytest.fixture(scope="session")
+def fem_reference_run(tmp_path_factory):
+    """:data:`FEM_REFERENCE_CASE` run once, uninterrupted, in this process; returns its file (read it only).
+
+    Shared by tests/test_fem_reference.py and tests/test_fem_kill.py, which compare their own runs of the
+    case with it byte for byte.
+    """
+    from stickslip.params import parse_params
+
+    path = tmp_path_factory.mktemp("fem-reference") / "run.h5"
+    plugin = registry.get("solver", "fem")
+    plugin.run(parse_params(plugin.params, FEM_REFERENCE_CASE), path, threads=1, inputs={})
+    return path
+
+
 @pytest.fixture(scope="session")
 def ci_study():
     """The real ci study (workflow/config/ci.yaml) run once with `snakemake --cores 2`; returns its directory.

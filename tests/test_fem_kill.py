@@ -15,28 +15,17 @@ import time
 
 import pytest
 
-from stickslip import registry
+from conftest import FEM_REFERENCE_CASE
 from stickslip.cli import main
 from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError, UnreadableFileError
-from stickslip.params import parse_params
 from stickslip.workflow_api import partial_path
 
 pytestmark = pytest.mark.slow
 
-CASE = {"N": 9, "nchunk": 200, "yield_strains": "stop"}  # the paper's reference case: 350 increments
-
-
-@pytest.fixture(scope="module")
-def uninterrupted(tmp_path_factory):
-    path = tmp_path_factory.mktemp("fem") / "run.h5"
-    plugin = registry.get("solver", "fem")
-    plugin.run(parse_params(plugin.params, CASE), path, threads=1, inputs={})
-    return path
-
 
 def _simulate_args(output):
-    params = [arg for key, value in CASE.items() for arg in ("--param", f"{key}={value}")]
+    params = [arg for key, value in FEM_REFERENCE_CASE.items() for arg in ("--param", f"{key}={value}")]
     return ["simulate", "--solver", "fem", *params, "-o", str(output)]
 
 
@@ -47,8 +36,8 @@ def _cli(output):
 def _workflow_job(output):
     code = ("import sys, json; from stickslip.workflow_api import run_simulation; "
             "run_simulation('fem', sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], inputs={}, threads=1)")
-    return [sys.executable, "-c", code, json.dumps(CASE), str(output), str(output.with_suffix(".json")),
-            str(output.with_suffix(".log"))]
+    return [sys.executable, "-c", code, json.dumps(FEM_REFERENCE_CASE), str(output),
+            str(output.with_suffix(".json")), str(output.with_suffix(".log"))]
 
 
 def _kill_when_stored(command, watched, increments, signum, timeout=600):
@@ -76,7 +65,7 @@ def _kill_when_stored(command, watched, increments, signum, timeout=600):
     return process.returncode, err, stored
 
 
-def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(uninterrupted, tmp_path):
+def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(fem_reference_run, tmp_path):
     output = tmp_path / "run.h5"
     status, err, _ = _kill_when_stored(_cli(output), output, 40, signal.SIGTERM)
     assert status == 128 + signal.SIGTERM, err
@@ -87,11 +76,11 @@ def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(uninterrupted, 
         assert not read_run_attrs(output)["completed"] and read_run_attrs(output)["nstored"] >= stored
     done = subprocess.run(_cli(output), capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    assert output.read_bytes() == uninterrupted.read_bytes()
+    assert output.read_bytes() == fem_reference_run.read_bytes()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"]  # no lock or temporary file left
 
 
-def test_a_killed_workflow_job_resumes_to_the_same_bytes(uninterrupted, tmp_path):
+def test_a_killed_workflow_job_resumes_to_the_same_bytes(fem_reference_run, tmp_path):
     output = tmp_path / "sim" / "fem" / "run.h5"
     partial = partial_path(output)
     for signum, increments in ((signal.SIGKILL, 100), (signal.SIGTERM, 220)):
@@ -102,18 +91,18 @@ def test_a_killed_workflow_job_resumes_to_the_same_bytes(uninterrupted, tmp_path
     done = subprocess.run(_workflow_job(output), capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "resuming from" in output.with_suffix(".log").read_text()
-    assert output.read_bytes() == uninterrupted.read_bytes() and not partial.exists()
+    assert output.read_bytes() == fem_reference_run.read_bytes() and not partial.exists()
 
 
-def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(uninterrupted, tmp_path, capsys):
+def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(fem_reference_run, tmp_path, capsys):
     output = tmp_path / "run.h5"
-    output.write_bytes(uninterrupted.read_bytes()[:5000])  # truncated: HDF5 cannot open it
+    output.write_bytes(fem_reference_run.read_bytes()[:5000])  # truncated: HDF5 cannot open it
     with pytest.raises(UnreadableFileError):
         read_increments(output)
     assert main(_simulate_args(output)) == 0
     err = capsys.readouterr().err
     assert f"moved it to {output}.unreadable, starting the run over" in err
-    assert output.read_bytes() == uninterrupted.read_bytes()
+    assert output.read_bytes() == fem_reference_run.read_bytes()
     assert (tmp_path / "run.h5.unreadable").stat().st_size == 5000
 
 

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import FEM_REFERENCE_CASE as REFERENCE_CASE
 from stickslip import registry
 from stickslip.cli import main
 from stickslip.fem.output import read_increments, read_run_attrs
@@ -16,8 +17,6 @@ from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
-REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "drive": "fixed-lever", "nchunk": 200,
-                  "yield_strains": "stop"}
 
 pytestmark = pytest.mark.slow
 
@@ -29,16 +28,9 @@ def _run(output, **values):
     return params
 
 
-@pytest.fixture(scope="module")
-def reference_run(tmp_path_factory):
-    path = tmp_path_factory.mktemp("fem") / "run.h5"
-    _run(path)
-    return path
-
-
 @pytest.mark.skipif(not REFERENCE.is_file(), reason="shared/reference/FixedLever_historic.h5 not available")
-def test_fixed_lever_reproduces_the_reference_on_every_increment(reference_run):
-    table = read_increments(reference_run)
+def test_fixed_lever_reproduces_the_reference_on_every_increment(fem_reference_run):
+    table = read_increments(fem_reference_run)
     with h5py.File(REFERENCE) as ref:
         expected = {"epsd": ref["epsd"][...], "sigd": ref["sigd"][...], "fxdrive": ref["fxdrive_layers"][...]}
     assert len(table) == expected["epsd"].size == 350
@@ -47,23 +39,23 @@ def test_fixed_lever_reproduces_the_reference_on_every_increment(reference_run):
     for name in got:
         np.testing.assert_allclose(got[name], expected[name], rtol=1e-9, atol=1e-12, err_msg=name)
     assert table["kick"].tolist() == [True] + [bool(i % 2 == 0) for i in range(1, 350)]
-    attrs = read_run_attrs(reference_run)
+    attrs = read_run_attrs(fem_reference_run)
     assert attrs["completed"] and attrs["stop_reason"] == "margin"
     assert attrs["n_interfaces"] == 1 and attrs["sig0"] == pytest.approx(1e-4)
 
 
-def test_same_parameters_give_identical_files_and_a_completed_file_is_left_alone(reference_run, tmp_path):
+def test_same_parameters_give_identical_files_and_a_completed_file_is_left_alone(fem_reference_run, tmp_path):
     again = tmp_path / "again.h5"
     _run(again)
-    assert again.read_bytes() == reference_run.read_bytes()
+    assert again.read_bytes() == fem_reference_run.read_bytes()
     before = again.stat().st_mtime_ns
     _run(again)  # completed: nothing to do
     assert again.stat().st_mtime_ns == before
 
 
-def test_an_interrupted_run_resumes_to_the_same_result(reference_run, tmp_path):
+def test_an_interrupted_run_resumes_to_the_same_result(fem_reference_run, tmp_path):
     partial = tmp_path / "partial.h5"
-    shutil.copy(reference_run, partial)
+    shutil.copy(fem_reference_run, partial)
     with h5py.File(partial, "r+") as file:  # as if killed while writing increment 121
         keep = 120
         for group in ("state", "increments"):
@@ -73,34 +65,34 @@ def test_an_interrupted_run_resumes_to_the_same_result(reference_run, tmp_path):
         file.attrs["completed"] = False
         file.attrs["stop_reason"] = ""
     _run(partial)
-    pd.testing.assert_frame_equal(read_increments(partial), read_increments(reference_run))
-    with h5py.File(partial) as a, h5py.File(reference_run) as b:
+    pd.testing.assert_frame_equal(read_increments(partial), read_increments(fem_reference_run))
+    with h5py.File(partial) as a, h5py.File(fem_reference_run) as b:
         np.testing.assert_array_equal(a["state/u"][...], b["state/u"][...])
         assert a.attrs["completed"] and a.attrs["nstored"] == b.attrs["nstored"]
 
 
-def test_rerun_records_every_block_failure_of_an_event(reference_run):
-    table = read_increments(reference_run)
+def test_rerun_records_every_block_failure_of_an_event(fem_reference_run):
+    table = read_increments(fem_reference_run)
     kicks = table[table["kick"] & (table["A_a1"] > 3)]
     increment = int(kicks["increment"].iloc[0])
-    events = EventReplay(reference_run).failures(increment)  # asserts it reproduces the stored increment
+    events = EventReplay(fem_reference_run).failures(increment)  # asserts it reproduces the stored increment
     assert list(events.columns) == ["a", "block", "t", "direction"]
     assert events["direction"].sum() == table["S_a1"][increment]
-    before, after = _indices(reference_run, increment)
+    before, after = _indices(fem_reference_run, increment)
     changed = set(np.flatnonzero(after != before))
     assert changed <= set(events["block"])
     assert events["t"].is_monotonic_increasing and events["t"].iloc[0] >= 0.0
     assert set(events["a"]) == {1}
 
 
-def test_one_replay_serves_every_event_of_a_run(reference_run):
+def test_one_replay_serves_every_event_of_a_run(fem_reference_run):
     """The model is built once per run file: replaying events in turn gives what fresh replays give."""
-    table = read_increments(reference_run)
+    table = read_increments(fem_reference_run)
     increments = table["increment"][table["kick"] & (table["A_a1"] > 0)].to_numpy()[:3]
-    shared = EventReplay(reference_run)
+    shared = EventReplay(fem_reference_run)
     for increment in increments[::-1]:  # out of order: each replay restores its own state
         pd.testing.assert_frame_equal(shared.failures(int(increment)),
-                                      EventReplay(reference_run).failures(int(increment)))
+                                      EventReplay(fem_reference_run).failures(int(increment)))
     with pytest.raises(FileFormatError, match="not a stored kick increment"):
         shared.failures(int(table["increment"][~table["kick"]].iloc[1]))
 
@@ -120,13 +112,13 @@ def _indices(path, increment):
     return np.array(out)
 
 
-def test_cli_writes_the_increments_table(reference_run, tmp_path, capsys):
+def test_cli_writes_the_increments_table(fem_reference_run, tmp_path, capsys):
     csv = tmp_path / "table.csv"
-    assert main(["increments", str(reference_run), "-o", str(csv)]) == 0
+    assert main(["increments", str(fem_reference_run), "-o", str(csv)]) == 0
     table = pd.read_csv(csv)
     for column in ("increment", "kick", "epsd", "sigd", "fxdrive_0", "fxdrive_1", "fxdrive_2", "S_a1", "A_a1"):
         assert column in table.columns
-    np.testing.assert_allclose(table["sigd"], read_increments(reference_run)["sigd"], rtol=1e-15)
+    np.testing.assert_allclose(table["sigd"], read_increments(fem_reference_run)["sigd"], rtol=1e-15)
     assert (table["fxdrive_0"] == 0).all() and (table["fxdrive_1"] == 0).all()
 
 
