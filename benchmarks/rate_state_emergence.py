@@ -13,7 +13,9 @@ deviation, sqrt(N) for a count; over seeds for R_slow):
 - P(T_1) against n: median, counts per 0.2 decade (peaks);
 - P(dmu_1) against n: mean, standard deviation, most populated 0.02 bin;
 - the aging fit (origin and free intercept) on all stack slips, and per n;
-- mean and standard deviation of B_a per interface and n, the latter normalised by n = 1;
+- mean and standard deviation of B_a per interface and n, the latter normalised by n = 1; and the
+  standard deviation within one seed (the paper's situation: one apparatus), median over the seeds,
+  normalised by the individual protocol's (seed 1);
 - R_slow per interface and n;
 - slips in multi-slip events.
 Slips in the first ``t_exclude`` = 300 s are already left out by the analysis.
@@ -107,6 +109,15 @@ def main(study):
         cells = [f"n={r.n}: {r.std:.4f}+-{errors.get(r.n, np.nan):.4f} ({r.std_normalised:.1f}x, N={r.count})"
                  for r in rows.itertuples()]
         print(f"  a={a}: " + "  ".join(cells))
+
+    print("\nstd(B_a) within one seed: median over the seeds per a and n (stack), normalised by the individual"
+          " protocol's (n = 1)")
+    individual = table[table["protocol"] == "individual"].groupby("a")["B_a"].std()
+    for a, part in table[table["protocol"] == "stack"].groupby("a"):
+        cells = [f"n={n}: {g.groupby('seed')['B_a'].std().median():.4f}"
+                 f" ({g.groupby('seed')['B_a'].std().median() / individual.get(a, np.nan):.1f}x)"
+                 for n, g in part.groupby("n") if n > 1]
+        print(f"  a={a}: n=1: {individual.get(a, np.nan):.4f}  " + "  ".join(cells))
 
     paths = sorted((Path(study) / "events" / "experiment-events").glob("*/*.h5"))
     interfaces = load_interfaces(paths)
