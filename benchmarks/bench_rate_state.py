@@ -31,7 +31,7 @@ def main(duration):
         try:
             dynamics.integrate(y0, 1.0, apparatus.shear_rate, method=method)  # compile
             start = time.perf_counter()
-            t, y, _ = dynamics.integrate(y0, duration, apparatus.shear_rate, method=method)
+            t, y, _, _ = dynamics.integrate(y0, duration, apparatus.shear_rate, method=method)
             wall = time.perf_counter() - start
         except RuntimeError as error:
             print(f"{method:8s} failed: {error}")

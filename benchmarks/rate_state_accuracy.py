@@ -38,8 +38,8 @@ def catalogue(values, method, rtol):
     """Ground truth, steps and CPU seconds of one run."""
     params = parse_params(RateStateLeverParams, dict(values, method=method, rtol=rtol))
     start = time.process_time()
-    _, truth, _, steps = simulate(params)
-    return truth, steps, time.process_time() - start
+    _, truth, _, integration = simulate(params)
+    return truth, integration["steps"], time.process_time() - start
 
 
 def agreement(truth, reference):

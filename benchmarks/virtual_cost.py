@@ -29,7 +29,7 @@ def cost(simulate, params_class, values):
     params = parse_params(params_class, values)
     start = time.process_time()
     out = simulate(params)
-    return time.process_time() - start, len(out[1]), out[3] if len(out) > 3 else None
+    return time.process_time() - start, len(out[1]), out[3]["steps"] if len(out) > 3 else None
 
 
 def main(seed, path_disorder=0.0):

@@ -9,7 +9,8 @@ slip follow from the equations, nothing is scheduled. Optionally (``path_disorde
 docs/experiment-model-rate-state.md.
 
 Output: the experimental time-series file with the attributes ``params`` (JSON), ``seed``, ``solver``,
-``solver_version`` and two ground-truth tables: ``truth`` (one row per interface per slip, see
+``solver_version``, ``integration`` (JSON: ``method``, accepted ``steps``, ``fallback`` and
+``fallback_spans``, see :func:`simulate`) and two ground-truth tables: ``truth`` (one row per interface per slip, see
 :func:`stickslip.experiment.virtual.slip_intervals.slip_intervals`) and ``interfaces`` (one row per
 interface: ``a``, ``slippable``, ``a_rs``, ``b``, ``D_c`` [mm], ``mu0``, ``K_c`` [N/mm] (linear-stability
 boundary ``N (b - a) / D_c``), ``n_slips``, ``slip_total``, ``creep_total`` (``R_total - slip_total``),
@@ -26,13 +27,13 @@ from .. import registry
 from ..experiment.timeseries import write_timeseries
 from ..experiment.virtual.model import apparatus as apparatus_of, per_interface, random_streams, sensor_signals
 from ..experiment.virtual.rate_state import RateStateLaw
-from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS, SlabDynamics
+from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, FALLBACK, METHODS, SlabDynamics
 from ..experiment.virtual.slip_intervals import slip_intervals
 from ..experiment.virtual.slip_path import PathProfiles
 from ..params import ParameterError, param, params_to_dict
 from .lever import LeverParams, check_protocol
 
-__all__ = ["RateStateLeverParams", "run", "simulate", "law_of"]
+__all__ = ["RateStateLeverParams", "run", "simulate", "law_of", "dynamics_of", "ground_truth"]
 
 VERSION = "2"  # 2: RODAS4 with relative slip-rate tolerances (issue 12, third session)
 
@@ -106,6 +107,60 @@ def law_of(params):
                         D_c=per_interface(params, "D_c") * spread[1], mu0=per_interface(params, "mu0"), V0=params.V0)
 
 
+def dynamics_of(params):
+    """The equations of motion of a run and its initial state.
+
+    Returns
+    -------
+    dynamics : SlabDynamics
+    R0 : numpy.ndarray
+        Slip of every interface at t = 0 [mm], [n_slabs].
+    y0 : numpy.ndarray
+        Initial state of the integration, [3 m + 1] (:meth:`SlabDynamics.initial_state`).
+    """
+    path = (PathProfiles.draw(params.seed, params.n_slabs, params.path_disorder, params.path_correlation_length)
+            if params.path_disorder > 0 else None)
+    dynamics = SlabDynamics(apparatus_of(params), law_of(params), params.slab_mass, params.load_mass, path=path)
+    R0, y0 = dynamics.initial_state(params.V_start, params.theta_start, params.gamma_start)
+    return dataclasses.replace(dynamics, path_origin=y0[:dynamics.interfaces.size]), R0, y0
+
+
+def ground_truth(params, dynamics, R0, trajectory):
+    """Every slip of an integrated trajectory and the slips at any time.
+
+    Parameters
+    ----------
+    params : RateStateLeverParams
+    dynamics, R0 : SlabDynamics, numpy.ndarray
+        From :func:`dynamics_of`.
+    trajectory : Trajectory
+        Its integration from t = 0 (:meth:`SlabDynamics.integrate`).
+
+    Returns
+    -------
+    truth : pandas.DataFrame
+        One row per interface per slip (:func:`~stickslip.experiment.virtual.slip_intervals.slip_intervals`).
+    slips_at : callable
+        ``slips_at(times [k]) -> [k, n_slabs]``: the slip of every interface [mm] (cubic Hermite
+        interpolation between the steps).
+    """
+    t, y, dydt = trajectory.t, trajectory.y, trajectory.dydt
+    index, m = dynamics.interfaces, dynamics.interfaces.size
+    spline = CubicHermiteSpline(t, y[:, :m], dydt[:, :m], axis=0)
+
+    def slips_at(times):
+        R = np.tile(R0, (np.size(times), 1))
+        R[:, index] = spline(np.asarray(times, dtype=float))
+        return R
+
+    law = dynamics.law
+    V = np.zeros((t.size, params.n_slabs))
+    V[:, index] = y[:, m:2 * m]
+    theta = np.zeros((t.size, params.n_slabs))
+    theta[:, index] = law.D_c[index] / law.V0 * np.exp(y[:, 2 * m:3 * m])
+    return slip_intervals(dynamics.apparatus, t, slips_at, V, theta, params.slip_velocity), slips_at
+
+
 def simulate(params):
     """Run the rate-and-state virtual experiment.
 
@@ -118,32 +173,18 @@ def simulate(params):
     record, truth, interfaces
         The sensor signals and the ground truth, as from the ``lever`` solver's
         :func:`~stickslip.experiment.virtual.model.simulate` (the tables' columns: module docstring).
-    steps : int
-        Accepted integrator steps.
+    integration : dict
+        How the run was integrated: ``method``, ``steps`` (accepted steps, int), ``fallback`` (the
+        method that takes over where ``method``'s step size underflows) and ``fallback_spans`` (start
+        and end [s] of every span it integrated: a list of pairs, empty for nearly every run).
     """
-    apparatus = apparatus_of(params)
-    law = law_of(params)
-    path = (PathProfiles.draw(params.seed, params.n_slabs, params.path_disorder, params.path_correlation_length)
-            if params.path_disorder > 0 else None)
-    dynamics = SlabDynamics(apparatus, law, params.slab_mass, params.load_mass, path=path)
-    R0, y0 = dynamics.initial_state(params.V_start, params.theta_start, params.gamma_start)
-    dynamics = dataclasses.replace(dynamics, path_origin=y0[:dynamics.interfaces.size])
-    t, y, dydt = dynamics.integrate(y0, params.duration, apparatus.shear_rate, method=params.method,
+    dynamics, R0, y0 = dynamics_of(params)
+    apparatus, law = dynamics.apparatus, dynamics.law
+    trajectory = dynamics.integrate(y0, params.duration, apparatus.shear_rate, method=params.method,
                                     rtol=params.rtol)
-    index, m = dynamics.interfaces, dynamics.interfaces.size
-    spline = CubicHermiteSpline(t, y[:, :m], dydt[:, :m], axis=0)
-
-    def slips_at(times):
-        R = np.tile(R0, (np.size(times), 1))
-        R[:, index] = spline(np.asarray(times, dtype=float))
-        return R
-
-    V = np.zeros((t.size, params.n_slabs))
-    V[:, index] = y[:, m:2 * m]
-    theta = np.zeros((t.size, params.n_slabs))
-    theta[:, index] = law.D_c[index] / law.V0 * np.exp(y[:, 2 * m:3 * m])
-    truth = slip_intervals(apparatus, t, slips_at, V, theta, params.slip_velocity)
+    truth, slips_at = ground_truth(params, dynamics, R0, trajectory)
     signals = sensor_signals(params, apparatus, slips_at, random_streams(params)[1])
+    index = dynamics.interfaces
     slippable = np.zeros(params.n_slabs, bool)
     slippable[index] = True
     a = np.arange(1, params.n_slabs + 1)
@@ -154,14 +195,17 @@ def simulate(params):
                                "mu0": law.mu0, "K_c": law.critical_stiffness(params.normal_force),
                                "n_slips": slips["size"].to_numpy(np.int64), "slip_total": slips["sum"].to_numpy(float),
                                "creep_total": R_total - slips["sum"].to_numpy(float), "R_total": R_total})
-    return signals, truth, interfaces, t.size - 1
+    integration = {"method": params.method, "steps": int(trajectory.t.size - 1), "fallback": FALLBACK,
+                   "fallback_spans": trajectory.fallback_spans.tolist()}
+    return signals, truth, interfaces, integration
 
 
 @registry.register("solver", "rate-state-lever", VERSION, RateStateLeverParams, produces="timeseries",
                    summary="virtual lever experiment with inertial slabs on rate-and-state (aging law) interfaces")
 def run(params, output, *, threads, inputs):
     """Run one rate-and-state virtual experiment and write its time-series file with the ground truth."""
-    signals, truth, interfaces, _ = simulate(params)
+    signals, truth, interfaces, integration = simulate(params)
     write_timeseries(output, signals, attrs={"params": params_to_dict(params), "seed": params.seed,
-                                             "solver": "rate-state-lever", "solver_version": VERSION},
+                                             "solver": "rate-state-lever", "solver_version": VERSION,
+                                             "integration": integration},
                      tables={"truth": truth, "interfaces": interfaces})
