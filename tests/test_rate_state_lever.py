@@ -270,7 +270,7 @@ def test_the_fallback_deep_in_a_stick_keeps_the_slips_of_a_tight_reference(tmp_p
         after = (trajectory.t > end + 0.01) & (trajectory.t < 688.0)
         statics = [apparatus.mu(t, np.concatenate([y[:5], R0[5:]]))[:5] for t, y in zip(trajectory.t[after],
                                                                                        trajectory.y[after])]
-        friction = dynamics.friction(trajectory.y[after, 5:10], trajectory.y[after, 10:15])
+        friction = dynamics.friction(trajectory.y[after, 5:10], trajectory.y[after, 10:15], trajectory.y[after, :5])
         np.testing.assert_allclose(friction, statics, rtol=0, atol=1e-5)
 
     slips, expected = (rate_state_lever.ground_truth(params, dynamics, R0, trajectory)[0] for trajectory in

@@ -99,7 +99,7 @@ def test_the_analytic_jacobian_and_the_structured_solve_include_the_slope_along_
     equals central differences of the right-hand side (to 1e-6 of each column's largest entry; the
     slip columns carry -C diag(d mu/d mu0 d mu0/dR) besides the springs), and the structured solve of
     (I - c J) u = r equals LAPACK's dense solve (to 1e-9)."""
-    apparatus, dynamics, _, (t, y, _) = _stack_n3(0.05)
+    apparatus, dynamics, _, (t, y, _, _) = _stack_n3(0.05)
     rate = apparatus.shear_rate
     states = y[np.linspace(0, t.size - 1, 25).astype(int)]
     states = np.vstack([states, y[np.abs(y[:, 3:6]).max(axis=1).argmax()]])  # the fastest slip
@@ -145,7 +145,7 @@ def test_steady_sliding_over_a_heterogeneous_path_averages_to_mu_ss_with_the_imp
     dynamics = SlabDynamics(apparatus, LAW, 0.143, 5.0, path=path)
     _, y0 = dynamics.initial_state(speed, LAW.D_c[0] / speed, 0.0)
     dynamics = SlabDynamics(apparatus, LAW, 0.143, 5.0, path=path, path_origin=y0[:1])
-    t, y, dydt = dynamics.integrate(y0, distance / speed, apparatus.shear_rate)
+    t, y, dydt, _ = dynamics.integrate(y0, distance / speed, apparatus.shear_rate)
     mu_ss, amplitude = float(LAW.steady_state(speed)[0]), epsilon * 0.35
     delta = y[:, 0] - y0[0]
     profile = np.array([level(0, R, dynamics._mu0, dynamics._path)[0] for R in y[:, 0]]) - 0.35
@@ -190,7 +190,7 @@ def test_with_path_disorder_runs_stay_deterministic_and_the_lever_balances(tmp_p
              for name, seed in (("a", 1), ("b", 1), ("c", 2))]
     digests = [hashlib.sha256(p.read_bytes()).hexdigest() for p in paths]
     assert digests[0] == digests[1] != digests[2]
-    apparatus, dynamics, R0, (t, y, dydt) = _stack_n3(0.02, duration=600.0)
+    apparatus, dynamics, R0, (t, y, dydt, _) = _stack_n3(0.02, duration=600.0)
     R = np.tile(R0, (t.size, 1))
     R[:, :3] = y[:, :3]
     F = apparatus.lever_force(apparatus.spring_forces(t, apparatus.positions(R)))
