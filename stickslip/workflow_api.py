@@ -35,7 +35,7 @@ __all__ = ["prepare_environment", "partial_path", "run_mesh", "run_simulation", 
            "build_database"]
 
 
-def prepare_environment(threads, numba_cache=""):
+def prepare_environment(threads, numba_cache="shared"):
     """Set the numba environment of a job; call before anything imports numba.
 
     (In a process that has imported numba already, as a test, ``NUMBA_NUM_THREADS``
@@ -45,11 +45,11 @@ def prepare_environment(threads, numba_cache=""):
     ----------
     threads : int
         The rule's threads: ``NUMBA_NUM_THREADS`` (numba's thread pool size).
-    numba_cache : {"", "job"}
+    numba_cache : {"shared", "job"}
         ``"job"``: compile into a fresh cache directory of this job under
         ``$TMPDIR`` (``NUMBA_CACHE_DIR``, removed when the process ends), as on a
-        cluster where many jobs share one file system; ``""``: numba's default
-        cache beside the sources.
+        cluster where many jobs share one file system; ``"shared"``: numba's cache
+        beside the sources (or ``$NUMBA_CACHE_DIR``), common to all jobs.
 
     Returns
     -------
@@ -66,8 +66,8 @@ def prepare_environment(threads, numba_cache=""):
         os.environ["NUMBA_CACHE_DIR"] = cache
         atexit.register(shutil.rmtree, cache, ignore_errors=True)
         return cache
-    if numba_cache:
-        raise ValueError(f"numba_cache must be '' or 'job', got {numba_cache!r}")
+    if numba_cache != "shared":
+        raise ValueError(f"numba_cache must be 'shared' or 'job', got {numba_cache!r}")
     return None
 
 
@@ -123,7 +123,7 @@ def _load(kind, name, params_json, module):
     return plugin, params
 
 
-def run_mesh(params_json, output, record, log, *, numba_cache=""):
+def run_mesh(params_json, output, record, log, *, numba_cache="shared"):
     """Write one mesh file.
 
     Parameters
@@ -132,7 +132,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache=""):
         :class:`stickslip.mesh.MeshParams` values as JSON.
     output, record, log : str or pathlib.Path
         Mesh file (HDF5), its provenance record, the log.
-    numba_cache : {"", "job"}
+    numba_cache : {"shared", "job"}
         See :func:`prepare_environment`.
     """
     prepare_environment(1, numba_cache)
@@ -148,7 +148,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache=""):
             mesh.write_mesh(params, Path(output))
 
 
-def run_simulation(solver, params_json, output, record, log, *, inputs, threads, numba_cache="", module=None):
+def run_simulation(solver, params_json, output, record, log, *, inputs, threads, numba_cache="shared", module=None):
     """Run one solver.
 
     Parameters
@@ -164,7 +164,7 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         their JSON (:meth:`stickslip.study.Study.dumps`).
     threads : int
         Threads of the parallel kernels.
-    numba_cache : {"", "job"}
+    numba_cache : {"shared", "job"}
         See :func:`prepare_environment`.
     module : str, optional
         The module that registers the plugin (see :func:`stickslip.registry.get`).
@@ -211,7 +211,7 @@ def partial_path(output):
     return output.parent / "partial" / output.name
 
 
-def run_analysis(analysis, params_json, simulation, output, record, log, *, numba_cache="", module=None):
+def run_analysis(analysis, params_json, simulation, output, record, log, *, numba_cache="shared", module=None):
     """Run one analysis on one simulation output.
 
     Parameters
@@ -224,7 +224,7 @@ def run_analysis(analysis, params_json, simulation, output, record, log, *, numb
         The simulation file as an artifact, JSON (path, run id, solver, format).
     output, record, log : str or pathlib.Path
         Table file (HDF5), its provenance record, the log.
-    numba_cache : {"", "job"}
+    numba_cache : {"shared", "job"}
         See :func:`prepare_environment`.
     module : str, optional
         The module that registers the plugin (see :func:`stickslip.registry.get`).
@@ -245,7 +245,7 @@ def run_analysis(analysis, params_json, simulation, output, record, log, *, numb
             plugin.run(params, simulation, Path(output))
 
 
-def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_cache="", module=None):
+def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_cache="shared", module=None):
     """Draw one figure.
 
     Parameters
@@ -259,7 +259,7 @@ def run_figure(figure, params_json, inputs_json, output, record, log, *, numba_c
         simulation as ``parent``).
     output, record, log : str or pathlib.Path
         The PDF (the PNG goes beside it), the provenance record, the log.
-    numba_cache : {"", "job"}
+    numba_cache : {"shared", "job"}
         See :func:`prepare_environment`.
     module : str, optional
         The module that registers the plugin (see :func:`stickslip.registry.get`).

@@ -99,8 +99,12 @@ def table(database, query):
 
 def test_ci_study_through_slurm_equals_the_local_run(cluster, ci_study, tmp_path):
     local, remote = ci_study, copy_workflow(tmp_path)
+    # The jobs load the kernels the local run compiled into numba's shared cache; the profile's default,
+    # a cache per job, would compile them again in every job, as if each ran on another node (the per-job
+    # cache itself: tests/test_workflow.py::test_job_environment_reaches_numba).
+    env = dict(cluster, STICKSLIP_SLURM_NUMBA_CACHE="shared")
     before = slurm_jobs(cluster)
-    status, output = run_snakemake(remote, cluster, *SLURM, *CI, timeout=1200)
+    status, output = run_snakemake(remote, env, *SLURM, *CI, timeout=1200)
     assert status == 0, output[-4000:]
     study = Study(yaml.safe_load((REPO / "workflow" / "config" / "ci.yaml").read_text()), ["ci.yaml"])
     submitted = new_jobs(cluster, before)
@@ -116,7 +120,7 @@ def test_ci_study_through_slurm_equals_the_local_run(cluster, ci_study, tmp_path
                   "SELECT analysis_run_id, simulation_run_id, analysis, solver, source, event, interface, slip, dmu, "
                   "multi, time, increment, extra FROM slip_events"):
         assert table(remote / study.path("database"), query) == table(local / study.path("database"), query)
-    again, output = run_snakemake(remote, cluster, *SLURM, *CI, "-n", timeout=300)
+    again, output = run_snakemake(remote, env, *SLURM, *CI, "-n", timeout=300)
     assert again == 0 and "Nothing to be done" in output
 
 

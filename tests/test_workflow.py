@@ -246,6 +246,11 @@ def test_job_environment_reaches_numba(tmp_path):
     threads, same, cache = result.stdout.split()
     assert threads == "2" and same == "True" and cache.startswith(str(tmp_path))
     assert not Path(cache).exists()  # removed when the job ends
+    code = ("from stickslip.workflow_api import prepare_environment\n"
+            "prepare_environment(1, 'node')\n")  # e.g. a typo in STICKSLIP_SLURM_NUMBA_CACHE (profiles/slurm)
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1
+    assert result.stderr.splitlines()[-1] == "ValueError: numba_cache must be 'shared' or 'job', got 'node'"
 
 
 def test_solvers_that_read_a_mesh_share_one_mesh_job():

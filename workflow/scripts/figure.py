@@ -3,5 +3,5 @@
 from stickslip.workflow_api import run_figure
 
 run_figure(snakemake.params.figure, snakemake.params.params, snakemake.params.inputs, snakemake.output.pdf,
-           snakemake.output.record, snakemake.log[0], numba_cache=snakemake.resources.get("numba_cache", ""),
+           snakemake.output.record, snakemake.log[0], numba_cache=snakemake.resources.get("numba_cache", "shared"),
            module=snakemake.params.module)
