@@ -13,7 +13,9 @@ tables as in :func:`stickslip.h5io.write_table`):
 ``slip_interfaces``
     one row per (slip event, slipping interface) (:func:`~stickslip.events.extraction.slip_interfaces`);
 ``sequences``
-    runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`).
+    runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`);
+``periodicity``
+    one row: the run's periodicity and synchronisation measures (:mod:`stickslip.events.periodicity`).
 
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
 plus ``phi`` (the rigidity ratio Phi, :func:`~stickslip.fem.stiffness.stiffness_ratio`),
@@ -32,12 +34,12 @@ from ..formats.analysis_file import write_analysis_file
 from ..formats.event_table import slip_events_table
 from ..h5io import FileFormatError
 from ..registry import register
-from . import extraction
+from . import extraction, periodicity
 
 __all__ = ["EventParams", "NAME", "VERSION", "event_tables", "slip_events", "event_attrs", "write_event_file", "run"]
 
 NAME = "numerical-events"
-VERSION = "1"
+VERSION = "2"  # 2: the table "periodicity"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,7 +48,7 @@ class EventParams:
 
 
 def event_tables(increments, N, *, source="increment table"):
-    """Return the four event tables of one run.
+    """Return the event tables of one run.
 
     Parameters
     ----------
@@ -60,7 +62,8 @@ def event_tables(increments, N, *, source="increment table"):
     Returns
     -------
     dict[str, pandas.DataFrame]
-        ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``.
+        ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``,
+        ``periodicity`` (:func:`stickslip.events.periodicity.periodicity_table`).
     """
     classified = extraction.classify_increments(increments, N, source=source)
     slips = extraction.slip_events(classified, N)
@@ -71,6 +74,7 @@ def event_tables(increments, N, *, source="increment table"):
         "slip_interfaces": per_interface,
         "sequences": extraction.slip_sequences(slips),
         "slip_events": slip_events(per_interface),
+        periodicity.TABLE: periodicity.periodicity_table(slips, len(extraction.interfaces_in(classified))),
     }
 
 
