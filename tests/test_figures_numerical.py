@@ -72,7 +72,7 @@ def study(tmp_path_factory):
 
 
 @pytest.mark.parametrize("name", ["fig2", "figS-dgamma", "figS-sequences", "figS-event-maps", "figS-tau",
-                                  "figS-phi-sweep"])
+                                  "figS-phi-sweep", "figS-size-series"])
 def test_figure_writes_pdf_and_png(study, tmp_path, name):
     figure = registry.get("figure", name)
     inputs = {category: study[category] for category in figure.inputs}

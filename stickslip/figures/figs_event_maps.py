@@ -39,6 +39,7 @@ class EventMapParams:
     n: int = param(2, "interfaces of the runs used (the paper: 2)", minimum=2)
     regime: str = param("stiff", "driving regime of the runs used (the paper's maps: stiff); any: both",
                         choices=("stiff", "compliant", "any"))
+    N: int = param(0, "blocks per interface of the runs used (0: every N of the study)", minimum=0)
     events: tuple[int, ...] = param((0, 1), "which re-run events to draw: ranks in the list of re-run events "
                                             "(multi-slips first) ordered by how close their c_f is to the median "
                                             "of the meaningful fits (0: the most typical)", minimum=0)
@@ -74,8 +75,8 @@ def branch_line(nucleation, speed, t0, length, sign, N, points=200):
     return np.insert(r, wraps, np.nan), np.insert(t, wraps, np.nan)
 
 
-def typical_events(files, n, regime):
-    """Re-run events of the runs with ``n`` interfaces (and ``regime``), the most typical first.
+def typical_events(files, n, regime, N=0):
+    """Re-run events of the runs with ``n`` interfaces, ``regime`` and ``N`` blocks, the most typical first.
 
     Parameters
     ----------
@@ -84,6 +85,8 @@ def typical_events(files, n, regime):
     n : int
     regime : str
         "stiff", "compliant" or "any".
+    N : int, optional
+        Blocks per interface; 0: any.
 
     Returns
     -------
@@ -97,7 +100,7 @@ def typical_events(files, n, regime):
     """
     chosen = []
     for item in sorted(files, key=lambda f: (f.regime, f.attrs.get("N", 0), f.attrs.get("seed", 0), f.path)):
-        if item.n != n or regime not in ("any", item.regime):
+        if item.n != n or regime not in ("any", item.regime) or N not in (0, int(item.attrs["N"])):
             continue
         for _, front in item.tables["fronts"].iterrows():
             chosen.append((item, front))
@@ -159,7 +162,7 @@ def _event_map(axes, item, front, median, count):
 def run(params, inputs, output):
     """SI: event maps (failure position against time) of two typical multi-slip events, n = 2, with c_f."""
     files = read_inputs(inputs, "analysis:front-dynamics", ("failures", "fronts"), NAME)
-    events, median, count = typical_events(files, params.n, params.regime)
+    events, median, count = typical_events(files, params.n, params.regime, params.N)
     fig = plt.figure(figsize=(3.5 * len(params.events), 4.0), constrained_layout=True)
     panels = fig.subfigures(1, len(params.events), squeeze=False)[0]
     for panel, index, letter in zip(panels, params.events, "abcdefgh"):
