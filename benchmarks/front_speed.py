@@ -17,6 +17,11 @@ profiled along each branch: Theil-Sen speed over consecutive windows of ``--prof
 blocks of distance from the nucleation block (the local speed against the distance the front
 has run).
 
+For the reconciliation with front-dynamics version 1 (the project's c_f before issue 23), every
+replay is also fitted the old way (:func:`version1_speed`): one least-squares line through the
+first failures of both branches against the periodic distance from the first block to fail, over
+0.3 ... 0.9 of half the interface, no quality check (column ``c_f_v1``).
+
 Printed: one line per (event, dt_scale) with both branches' speeds and qualities for every
 window; then per (N, dt_scale, window) the median and the mean with its standard error of the
 meaningful fits (quality "ok", :func:`~stickslip.events.fronts.analyse_event`) and how many were
@@ -64,6 +69,19 @@ def replays(path, scales, max_events):
             failures = pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - before[3],
                                      "direction": events[:, 2].astype(np.int64)})
             yield increment, float(scale), failures, reproduced
+
+
+def version1_speed(failures, a, N, fit_from=0.3, fit_to=0.9):
+    """Front speed [blocks per FE time] as front-dynamics version 1 fitted it (module doc); NaN if not positive."""
+    first = failures[failures["a"] == a].groupby("block")["t"].min()
+    blocks, times = first.index.to_numpy(), first.to_numpy()
+    offset = np.abs(blocks - blocks[np.argmin(times)])
+    distance = np.minimum(offset, N - offset).astype(float)
+    fitted = (distance >= fit_from * N / 2) & (distance <= fit_to * N / 2)
+    if fitted.sum() < 3:
+        return math.nan
+    slope = np.polyfit(distance[fitted], times[fitted], 1)[0]
+    return 1.0 / slope if slope > 0 else math.nan
 
 
 def profile(failures, a, N, nucleation, meeting, width):
@@ -117,12 +135,13 @@ def main(argv=None):
             for fit_from, fit_to in windows:
                 row = fronts.analyse_event(failures, N, h=h, c_s=c_s, spacing=spacing, c_d=c_d, fit_from=fit_from,
                                            fit_to=fit_to)
+                old = version1_speed(failures, row["a_first"], N) * h / c_s if row["s"] else math.nan
                 rows.append({"run": path.stem, "N": N, "seed": attrs["seed"], "phi": attrs["phi"], "run_dt": own,
                              "increment": increment, "dt_scale": scale, "window": f"{fit_from:g}:{fit_to:g}",
-                             **row})
+                             **row, "c_f_v1": old})
                 line.append(f"[{fit_from:g}:{fit_to:g}] s={row['s']} c_f={row['c_f']:.2f} "
                             f"(right {row['c_f_right']:.2f} {row['quality_right']}, left {row['c_f_left']:.2f} "
-                            f"{row['quality_left']}) tau={row['tau']:.2f}")
+                            f"{row['quality_left']}) v1={old:.2f} tau={row['tau']:.2f}")
             if row["s"] >= 1:
                 for item in profile(failures, row["a_first"], N, row["nucleation"], row["meeting"],
                                     args.profile_width):
@@ -140,7 +159,8 @@ def main(argv=None):
         print(f"N={key[0]} run_dt={key[1]:g} dt_scale={key[2]:g} window={key[3]}: events={len(group)} ok={ok.size} "
               f"flagged={len(group) - ok.size} median={np.median(ok) if ok.size else math.nan:.3f} "
               f"mean={ok.mean() if ok.size else math.nan:.3f}+-{error:.3f} c_s "
-              f"(multi-slip in the replay: {int((group['s'] >= 2).sum())})")
+              f"(multi-slip in the replay: {int((group['s'] >= 2).sum())}); version 1 fit, every event: median "
+              f"{group['c_f_v1'].median():.3f}, range {group['c_f_v1'].min():.2f}-{group['c_f_v1'].max():.2f}")
     if profiles:
         local = pd.DataFrame(profiles)
         print(f"\nlocal front speed [c_s] against distance from the nucleation block (windows of "
