@@ -79,13 +79,15 @@ def main(trees):
               f"sequences single={sequences['single']:.2f} any={sequences['any']:.2f}")
     print("\ncompliant single slips, Delta mu_a [sig0] against n = 1 (Welch on events; on run means):")
     for _, row in drop_shift_by_size(events).iterrows():
-        print(f"N={row['N']} dt_scale={row['dt_scale']:g} n={row['n']}: seeds={row['seeds']} count={row['count']} "
+        print(f"N={int(row['N'])} dt_scale={row['dt_scale']:g} n={int(row['n'])}: seeds={int(row['seeds'])} "
+              f"count={int(row['count'])} "
               f"mean={row['mean']:.4f} +- {row['run_mean_error']:.4f} (runs) shift={100 * row['shift']:+.1f} % "
               f"p={row['p_value']:.2g} detectable={100 * row['detectable_shift']:.1f} % p_runs={row['p_runs']:.2g}")
     fronts = read(trees, "front-dynamics", ("fronts",))
     if fronts:
         print("\nfront speed c_f [c_s] of the re-run multi-slips (meaningful fits only) and tau [H/c_s]:")
-        for _, row in front_speed_by_size(fronts).iterrows():
+        table = front_speed_by_size(fronts)
+        for _, row in table[table["events"] > 0].iterrows():
             print(f"N={row['N']} dt_scale={row['dt_scale']:g} {row['regime']} n={row['n']}: events={row['events']} "
                   f"ok={row['ok']} flagged={row['flagged']} c_f median={row['c_f_median']:.2f} "
                   f"mean={pm(row['c_f_mean'], row['c_f_error'])} tau median={row['tau_median']:.2f} "
