@@ -60,7 +60,7 @@ from stickslip.events.extraction import classify_increments, slip_events, slip_i
 from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
 from stickslip.fem.dynamics import time_step
 from stickslip.fem.observables import Observer
-from stickslip.fem.output import RunFile, read_increments, read_run_attrs
+from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.stiffness import stiffness_ratio
 from stickslip.fem.system import System

@@ -1,7 +1,7 @@
 """Event extraction on synthetic increment tables with known answers.
 
 :func:`history` builds the table a quasistatic ``fem`` run would give for a scripted
-sequence of events; other test modules import it.
+sequence of events, :func:`run_attrs` the header of its file; other test modules import them.
 """
 
 import numpy as np
@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from stickslip.events import extraction as ex
+from stickslip.fem.stiffness import driving_regime, stiffness_ratio
 from stickslip.h5io import FileFormatError
 
 
@@ -55,6 +56,14 @@ def history(N, events, *, load_gamma=1.0, elastic_modulus=1.0):
         table[f"sigd_{layer}"] = values
         table[f"epsd_{layer}"] = table["epsd"]
     return table
+
+
+def run_attrs(N, plates, k_drive, **further):
+    """Root attributes of a synthetic ``fem`` run file: its typed header with ``phi`` and ``regime``
+    as the solver states them (:mod:`stickslip.fem.stiffness`), then ``further``."""
+    phi = stiffness_ratio(k_drive, N)
+    return {"N": N, "plates": plates, "n_interfaces": plates - 1, "k_drive": k_drive, "phi": phi,
+            "regime": driving_regime(phi), **further}
 
 
 N = 9
@@ -172,12 +181,3 @@ def test_bad_tables_are_refused_with_the_column_named():
         ex.classify_increments(table.drop(index=5), N)
     with pytest.raises(FileFormatError, match="S_a"):
         ex.interfaces_in(table[["increment", "gamma"]])
-
-
-def test_driving_regime_is_judged_at_the_paper_size():
-    assert ex.driving_regime(1e-3) == "stiff"
-    assert ex.driving_regime(1e-6) == "compliant"
-    assert ex.driving_regime(1e-3, 1458) == "stiff"
-    # plates M = N // 4 blocks thick: Phi ~ k h_p^2, so k = 1e-3 at N = 54 (M = 13) drives far more compliantly
-    assert ex.driving_regime(1e-3, 54) == "compliant"
-    assert ex.driving_regime(1e-3 * (364 / 13) ** 2, 54) == "stiff"

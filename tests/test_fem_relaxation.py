@@ -10,7 +10,7 @@ import pytest
 from stickslip import registry
 from stickslip.fem.dynamics import residual
 from stickslip.fem.forces import compute_force, wells_hold
-from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.system import System, derived_constants
 from stickslip.mesh import MeshParams, build_stack_mesh

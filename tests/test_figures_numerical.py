@@ -15,7 +15,7 @@ from stickslip.figures import figs_sequences
 from stickslip.events.results import group_runs, read_analysis_file
 from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
-from test_events_extraction import history
+from test_events_extraction import history, run_attrs
 from test_fronts import C_S, H_BLOCK, SPACING, rupture
 
 N = 27
@@ -49,7 +49,7 @@ def study(tmp_path_factory):
     event_files, front_files = [], []
     for regime in ("stiff", "compliant"):
         for n in (1, 2, 3):
-            attrs = {"N": N, "plates": n + 1, "k_drive": K_DRIVE[regime], "seed": 0, "c_s": C_S, "h": H_BLOCK}
+            attrs = run_attrs(N, n + 1, K_DRIVE[regime], seed=0, c_s=C_S, h=H_BLOCK)
             tables = plugin.event_tables(history(N, random_events(n, regime, rng), load_gamma=0.7), N)
             path = root / f"events-{regime}-{n}.h5"
             plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path, input=__file__)
@@ -106,7 +106,7 @@ def test_sequence_fractions_plotted_are_the_pooled_ones(study):
 def test_paper_figures_leave_out_runs_away_from_the_paper_phi(study, tmp_path):
     from stickslip.figures.numerical_common import read_inputs
 
-    attrs = {"N": N, "plates": 3, "k_drive": K_DRIVE["stiff"] / 30, "seed": 0, "c_s": C_S, "h": H_BLOCK}
+    attrs = run_attrs(N, 3, K_DRIVE["stiff"] / 30, seed=0, c_s=C_S, h=H_BLOCK)
     tables = plugin.event_tables(history(N, random_events(2, "stiff", np.random.default_rng(1)), load_gamma=0.7), N)
     sweep = tmp_path / "sweep.h5"
     plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), sweep, input=__file__)

@@ -27,6 +27,7 @@ import pandas as pd
 
 from .. import h5io, registry
 from ..formats.analysis_file import write_analysis_file
+from ..formats.fem_run import read_increments, read_run_attrs
 from ..h5io import FileFormatError
 from ..lineage import Artifact
 from ..mesh import interface_layer, load_mesh
@@ -293,8 +294,6 @@ def _replay(input):
 @register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
-    from ..fem.output import read_increments, read_run_attrs
-
     replay = _replay(input)
     run_attrs = read_run_attrs(input)
     for key in ("N", "h", "c_s"):

@@ -16,20 +16,19 @@ tables as in :func:`stickslip.h5io.write_table`):
     runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`).
 
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
-plus ``phi`` (the rigidity ratio Phi, :func:`~stickslip.fem.stiffness.stiffness_ratio`),
-``regime`` ("stiff" or "compliant", from ``phi``), ``steady_state`` (first steady-state increment,
+with the run's ``phi`` (the rigidity ratio Phi) and ``regime`` ("stiff" or "compliant") as the run file
+states them, ``steady_state`` (first steady-state increment,
 -1 if not reached) and the analysis header.
 """
 
 import dataclasses
-import json
 
 import numpy as np
 import pandas as pd
 
-from ..fem.stiffness import driving_regime, stiffness_ratio
 from ..formats.analysis_file import write_analysis_file
 from ..formats.event_table import slip_events_table
+from ..formats.fem_run import read_increments, read_run_attrs
 from ..h5io import FileFormatError
 from ..registry import register
 from . import extraction
@@ -51,7 +50,7 @@ def event_tables(increments, N, *, source="increment table"):
     Parameters
     ----------
     increments : pandas.DataFrame
-        The solver's increment table (see :func:`stickslip.fem.output.read_increments`).
+        The solver's increment table (see :func:`stickslip.formats.fem_run.read_increments`).
     N : int
         Blocks per interface.
     source : str, optional
@@ -96,13 +95,13 @@ def slip_events(per_interface):
 
 
 def event_attrs(run_attrs, classified, *, source="run"):
-    """Return the attributes of an event file: the run's, plus regime and steady state.
+    """Return the attributes of an event file: the run's (with its ``phi`` and ``regime``), plus the steady state.
 
     Parameters
     ----------
     run_attrs : Mapping[str, object]
-        Attributes of the run (see :func:`stickslip.fem.output.read_run_attrs`); must
-        hold ``N``, ``plates`` and ``k_drive``.
+        Attributes of the run (see :func:`stickslip.formats.fem_run.read_run_attrs`); must
+        hold ``N``, ``plates``, ``phi`` and ``regime``.
     classified : pandas.DataFrame
         Output of :func:`~stickslip.events.extraction.classify_increments`.
     source : str, optional
@@ -112,15 +111,11 @@ def event_attrs(run_attrs, classified, *, source="run"):
     -------
     dict[str, object]
     """
-    missing = [key for key in ("N", "plates", "k_drive") if key not in run_attrs]
+    missing = [key for key in ("N", "plates", "phi", "regime") if key not in run_attrs]
     if missing:
         raise FileFormatError(f"{source}: run attributes lack {', '.join(missing)}")
     attrs = dict(run_attrs)
     attrs["n_interfaces"] = int(run_attrs["plates"]) - 1
-    params = run_attrs.get("params", {})
-    G = (json.loads(params) if isinstance(params, str) else params).get("G", 1.0)
-    attrs["phi"] = stiffness_ratio(run_attrs["k_drive"], run_attrs["N"], G)
-    attrs["regime"] = driving_regime(attrs["phi"])
     steady = classified["increment"][classified["steady"]]
     attrs["steady_state"] = int(steady.iloc[0]) if steady.size else -1
     return attrs
@@ -147,8 +142,6 @@ def write_event_file(tables, attrs, output, *, input, params=EventParams()):
 @register("analysis", NAME, VERSION, EventParams, consumes=("fem-run",), produces="event-table")
 def run(params, input, output):
     """Slip and microscopic events of a quasistatic fem run (steady state, rho(s), sequences)."""
-    from ..fem.output import read_increments, read_run_attrs  # the solver loads numba kernels
-
     run_attrs = read_run_attrs(input)
     if "N" not in run_attrs:
         raise FileFormatError(f"{input}: run attributes lack N")

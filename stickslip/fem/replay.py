@@ -9,8 +9,9 @@ and runs the same kick and minimisation as the run (:meth:`.system.System.kick_a
 import numpy as np
 import pandas as pd
 
-from ..h5io import FileFormatError, open_file, read_table
-from .output import RunFile
+from ..formats.fem_run import RunFile
+from ..h5io import FileFormatError, open_file
+from .parameters import stored_params
 from .system import System
 
 __all__ = ["EventReplay"]
@@ -34,11 +35,11 @@ class EventReplay:
         self.path = path
         with open_file(path) as file:
             run = RunFile(file)
-            self.params, self.nstored = run.params, run.nstored
-            table = read_table(file, "increments", rows=run.nstored)
+            self.params, self.nstored = stored_params(file), run.nstored
+            table = run.increments()
             response = run.linear_response()
             self.N = run.mesh.N
-            self.system = System(run.params, run.mesh)
+            self.system = System(self.params, run.mesh)
         self._kick = table["kick"].to_numpy(dtype=bool)
         self._yield_element = table["yield_element"].to_numpy(dtype=bool)
         self.system.set_linear_response(*response)

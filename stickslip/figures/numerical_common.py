@@ -3,7 +3,7 @@ figS-event-maps, figS-tau): reading their inputs, line styles per driving regime
 """
 
 from ..events.results import read_analysis_file
-from ..fem.stiffness import at_paper_phi, stiffness_ratio
+from ..fem.stiffness import at_paper_phi
 from ..h5io import FileFormatError
 
 __all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "read_inputs", "run_phi"]
@@ -16,10 +16,8 @@ REGIME_LABEL = {"stiff": r"stiff driving, $\Phi \simeq 5 \times 10^{-4}$",
 
 
 def run_phi(attrs):
-    """Phi of the run an analysis file comes from (its ``phi`` attribute, or from ``k_drive`` and ``N``)."""
-    if "phi" in attrs:
-        return float(attrs["phi"])
-    return stiffness_ratio(attrs["k_drive"], attrs["N"])
+    """Phi of the run an analysis file comes from: its ``phi`` attribute, as the run file states it (float)."""
+    return float(attrs["phi"])
 
 
 def read_inputs(inputs, category, tables, figure, paper_phi=True):
