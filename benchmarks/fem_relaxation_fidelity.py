@@ -56,7 +56,7 @@ from scipy import sparse, stats
 from scipy.sparse.linalg import eigsh
 
 from stickslip import registry
-from stickslip.events.extraction import classify_increments, slip_events, slip_interfaces
+from stickslip.events.extraction import classify_increments, slip_interfaces, steady_slips
 from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
 from stickslip.fem.dynamics import time_step
 from stickslip.fem.observables import Observer
@@ -155,7 +155,7 @@ def _slip_sample(label, params, args):
     classified = classify_increments(table, N)
     if args.start is not None:  # instead of the extraction's steady state (needs every interface to slip once)
         classified["steady"] = classified["increment"].to_numpy() >= args.start
-    slips = slip_events(classified, N)
+    slips = steady_slips(classified, N)
     counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
     drops = slip_interfaces(classified, N)["dmu"].to_numpy()
     events = classified["kick"].to_numpy() & classified["steady"].to_numpy(dtype=bool)

@@ -111,12 +111,12 @@ def test_no_steady_state_without_softening_or_without_a_slip_everywhere():
     assert ex.steady_state(history(N, [MICRO] * 6), N) is None
     classified = ex.classify_increments(history(N, [SLIP1] * 6), N)
     assert not classified["steady"].any()
-    assert ex.slip_events(classified, N).empty
+    assert ex.steady_slips(classified, N).empty
 
 
 def test_slip_events_and_their_interfaces():
     classified = ex.classify_increments(history(N, EVENTS), N)
-    slips = ex.slip_events(classified, N)
+    slips = ex.steady_slips(classified, N)
     # steady state from increment 8: SLIP2, SLIP1, MULTI, MULTI, SLIP2, SLIP1, MULTI
     assert slips["increment"].tolist() == [8, 12, 14, 16, 18, 22, 24]
     assert slips["interfaces"].tolist() == ["2", "1", "1,2", "1,2", "2", "1", "1,2"]
@@ -145,7 +145,7 @@ def test_stress_drop_and_shear_since_the_previous_slip_of_the_same_interface():
 
 def test_rho_of_s():
     classified = ex.classify_increments(history(N, EVENTS), N)
-    slips = ex.slip_events(classified, N)
+    slips = ex.steady_slips(classified, N)
     np.testing.assert_allclose(ex.slip_fractions(slips, 2), [4 / 7, 3 / 7])
     np.testing.assert_allclose(ex.slip_fractions(slips, 3), [4 / 7, 3 / 7, 0])
     assert np.isnan(ex.slip_fractions(slips.iloc[:0], 2)).all()
@@ -153,7 +153,7 @@ def test_rho_of_s():
 
 def test_sequences_of_single_and_multi_slips():
     classified = ex.classify_increments(history(N, EVENTS), N)
-    sequences = ex.slip_sequences(ex.slip_events(classified, N))
+    sequences = ex.slip_sequences(ex.steady_slips(classified, N))
     # single, single | multi, multi | single, single | multi
     assert sequences["kind"].tolist() == ["single", "multi", "single", "multi"]
     assert sequences["length"].tolist() == [2, 2, 2, 1]
@@ -168,7 +168,7 @@ def test_sequences_of_single_and_multi_slips():
 
 def test_alternating_slips_form_no_sequence():
     events = [SLIP1, MULTI] * 4  # steady from the first multi-slip
-    sequences = ex.slip_sequences(ex.slip_events(ex.classify_increments(history(N, events), N), N))
+    sequences = ex.slip_sequences(ex.steady_slips(ex.classify_increments(history(N, events), N), N))
     assert (sequences["length"] == 1).all()
     assert ex.sequence_fractions(sequences) == {"single": 0, "multi": 0, "any": 0}
 

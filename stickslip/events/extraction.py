@@ -31,7 +31,7 @@ __all__ = [
     "interfaces_in",
     "steady_state",
     "classify_increments",
-    "slip_events",
+    "steady_slips",
     "slip_interfaces",
     "slip_fractions",
     "slip_sequences",
@@ -171,7 +171,7 @@ def _slip_rows(classified):
     return classified["kind"].isin(("single", "multi")).to_numpy() & classified["steady"].to_numpy(dtype=bool)
 
 
-def slip_events(classified, N):
+def steady_slips(classified, N):
     """Return the slip events of the steady state, one row each.
 
     Parameters
@@ -249,7 +249,7 @@ def slip_fractions(slips, n):
     Parameters
     ----------
     slips : pandas.DataFrame
-        Slip events (column ``s``), e.g. of :func:`slip_events`; several runs may be
+        Slip events (column ``s``), e.g. of :func:`steady_slips`; several runs may be
         concatenated.
     n : int
         Number of interfaces.

@@ -9,7 +9,7 @@ tables as in :func:`stickslip.h5io.write_table`):
 ``increments``
     every stored increment, classified (:func:`~stickslip.events.extraction.classify_increments`);
 ``slips``
-    one row per steady-state slip event (:func:`~stickslip.events.extraction.slip_events`);
+    one row per steady-state slip event (:func:`~stickslip.events.extraction.steady_slips`);
 ``slip_interfaces``
     one row per (slip event, slipping interface) (:func:`~stickslip.events.extraction.slip_interfaces`);
 ``sequences``
@@ -33,7 +33,7 @@ from ..h5io import FileFormatError
 from ..registry import register
 from . import extraction
 
-__all__ = ["EventParams", "NAME", "VERSION", "event_tables", "slip_events", "event_attrs", "write_event_file", "run"]
+__all__ = ["EventParams", "NAME", "VERSION", "event_tables", "numerical_slip_events", "event_attrs", "write_event_file", "run"]
 
 NAME = "numerical-events"
 VERSION = "1"
@@ -62,18 +62,18 @@ def event_tables(increments, N, *, source="increment table"):
         ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``.
     """
     classified = extraction.classify_increments(increments, N, source=source)
-    slips = extraction.slip_events(classified, N)
+    slips = extraction.steady_slips(classified, N)
     per_interface = extraction.slip_interfaces(classified, N)
     return {
         "increments": classified,
         "slips": slips,
         "slip_interfaces": per_interface,
         "sequences": extraction.slip_sequences(slips),
-        "slip_events": slip_events(per_interface),
+        "slip_events": numerical_slip_events(per_interface),
     }
 
 
-def slip_events(per_interface):
+def numerical_slip_events(per_interface):
     """The normalised slip table (format ``event-table``) of a run's ``slip_interfaces`` table.
 
     Parameters
@@ -143,8 +143,6 @@ def write_event_file(tables, attrs, output, *, input, params=EventParams()):
 def run(params, input, output):
     """Slip and microscopic events of a quasistatic fem run (steady state, rho(s), sequences)."""
     run_attrs = read_run_attrs(input)
-    if "N" not in run_attrs:
-        raise FileFormatError(f"{input}: run attributes lack N")
     tables = event_tables(read_increments(input), int(run_attrs["N"]), source=str(input))
     write_event_file(tables, event_attrs(run_attrs, tables["increments"], source=str(input)), output, input=input,
                      params=params)
