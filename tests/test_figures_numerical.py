@@ -94,7 +94,7 @@ def test_figure_inputs_say_what_is_missing(study, tmp_path):
 
 
 def test_sequence_fractions_plotted_are_the_pooled_ones(study):
-    files = [read_analysis_file(p, ("sequences",)) for p in study["analysis:numerical-events"]]
+    files = [read_analysis_file(p, "event-table", ("sequences",)) for p in study["analysis:numerical-events"]]
     n, single, any_ = figs_sequences.fractions_by_n(group_runs(files), "compliant")
     np.testing.assert_array_equal(n, [1, 2, 3])
     np.testing.assert_allclose(single, 1.0)  # compliant: only single slips, all in one sequence

@@ -11,6 +11,8 @@ import pandas as pd
 
 from .. import h5io
 from ..experiment.timeseries import read_timeseries
+from ..formats import event_table
+from ..formats.analysis_file import open_analysis_file
 
 __all__ = ["EVENTS", "load_slips", "load_interfaces", "example_run", "excerpt"]
 
@@ -38,7 +40,7 @@ def _run_attrs(f, path):
 def _load(paths, table):
     frames = []
     for path in sorted(map(str, paths)):
-        with h5io.open_file(path) as f:
+        with open_analysis_file(path, event_table.FORMAT) as f:
             attrs = _run_attrs(f, path)
             data = h5io.read_table(f, table)
         data = data.drop(columns=[c for c in ("n", "protocol") if c in data.columns])

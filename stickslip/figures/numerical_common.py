@@ -4,9 +4,13 @@ figS-event-maps, figS-tau): reading their inputs, line styles per driving regime
 
 from ..events.results import read_analysis_file
 from ..fem.stiffness import at_paper_phi
+from ..formats import event_table, front_table
 from ..h5io import FileFormatError
 
-__all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "read_inputs", "run_phi"]
+__all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "INPUT_FORMATS", "read_inputs", "run_phi"]
+
+#: The format of each input category of the numerical figures.
+INPUT_FORMATS = {"analysis:numerical-events": event_table.FORMAT, "analysis:front-dynamics": front_table.FORMAT}
 
 #: The paper's convention: stiff driving dashed, compliant solid.
 REGIME_LINESTYLE = {"stiff": "--", "compliant": "-"}
@@ -28,7 +32,7 @@ def read_inputs(inputs, category, tables, figure, paper_phi=True):
     inputs : Mapping[str, Sequence[str or pathlib.Path]]
         The figure's inputs, by category.
     category : str
-        E.g. ``"analysis:numerical-events"``.
+        A key of :data:`INPUT_FORMATS`, e.g. ``"analysis:numerical-events"``.
     tables : tuple[str, ...]
         Tables to read from each file.
     figure : str
@@ -45,12 +49,12 @@ def read_inputs(inputs, category, tables, figure, paper_phi=True):
     Raises
     ------
     FileFormatError
-        If the category has no file (at the paper's Phi).
+        If the category has no file (at the paper's Phi), or a file is not of the category's format.
     """
     paths = list(inputs.get(category, []))
     if not paths:
         raise FileFormatError(f"figure '{figure}': no input file of category '{category}'")
-    files = [read_analysis_file(path, tables) for path in paths]
+    files = [read_analysis_file(path, INPUT_FORMATS[category], tables) for path in paths]
     if paper_phi:
         files = [item for item in files if at_paper_phi(run_phi(item.attrs))]
         if not files:

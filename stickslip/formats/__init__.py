@@ -16,7 +16,7 @@ mesh           :mod:`stickslip.mesh.io`                 mesh stage -> ``fem`` (s
 fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics
 timeseries     :mod:`stickslip.experiment.timeseries`   ``lever``, lab CSV import -> experiment-events
 event-table    :mod:`stickslip.formats.event_table`     numerical-events, experiment-events -> figures, database
-front-table    :mod:`stickslip.events.fronts`           front-dynamics -> figS-event-maps, figS-tau
+front-table    :mod:`stickslip.formats.front_table`     front-dynamics -> figS-event-maps, figS-tau
 =============  =======================================  ========================================
 
 A simulation format says what kind of data it holds (``source``: "numerical" or
@@ -190,6 +190,6 @@ for _builtin in (
                describe="stickslip.experiment.timeseries:describe"),
         Format("event-table", 1, "stickslip.formats.event_table", "slip events: one row per (event, slipping "
                "interface) in the table 'slip_events', plus the analysis's own tables"),
-        Format("front-table", 1, "stickslip.events.fronts", "re-run events: block failures and rupture fronts"),
+        Format("front-table", 1, "stickslip.formats.front_table", "re-run events: block failures and rupture fronts"),
 ):
     register_format(_builtin)
