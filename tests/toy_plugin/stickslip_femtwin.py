@@ -8,6 +8,7 @@ The package's analyses, figures and database take its runs with no edit
 (tests/test_second_solver.py).
 """
 
+from stickslip.fem.backends import make_backend
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.replay import EventReplay
 from stickslip.fem.run import run_simulation
@@ -20,4 +21,5 @@ VERSION = "1"
 @register("solver", "fem-twin", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads, inputs):
     """The fem model under another name (test plugin: a second fem-run solver)."""
-    run_simulation(params, output, stack_mesh(params, inputs), threads=threads, producer=("fem-twin", VERSION))
+    run_simulation(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
+                   producer=("fem-twin", VERSION))
