@@ -26,8 +26,10 @@ positive definite (the bottom edge is fixed): it is factorised once with SuperLU
 the exact stiffness and one iteration is the solution.
 
 The iterations stop when the relative residual (:func:`.dynamics.residual`, at rest)
-is below ``tol^2`` (the dynamic protocol's strict criterion), or when it has not halved
-in ``STALL`` consecutive iterations (round-off floor, or no convergence), or after
+is below ``tol^2`` (the dynamic protocol's strict criterion), or when the smallest residual
+has not halved in the last ``STALL`` iterations, neither in one of them nor over all of them
+(round-off floor, or no convergence; a law whose curvature is well below the matrix's, as the
+smooth law's beyond an inflection, contracts steadily but more slowly than by half per iteration), or after
 ``MAX_NEWTON`` iterations; the result counts only if its residual is below ``tol^2``, or
 below ``tol`` at a stall (a round-off floor above ``tol^2``, for a very small ``tol``). All operations are serial and in a fixed order: the result
 is the same bit for bit on every run.
@@ -146,16 +148,20 @@ class WellEquilibrium:
         trial.a[:] = 0.0
         backend.force(model, trial, update_wells=False)
         best = backend.residual(model, trial)
-        stalled = 0
+        bests = [best]  # the smallest residual after each iteration
+        stalled = 0  # consecutive iterations that did not halve it
+        stuck = False
         for _ in range(MAX_NEWTON):
-            if best <= tol * tol or stalled >= STALL:
+            stuck = stalled >= STALL and best > 0.5 * bests[-1 - STALL]
+            if best <= tol * tol or stuck:
                 break
             trial.u[self.free] -= self.solve(trial.f[self.free])
             backend.force(model, trial, update_wells=False)
             current = backend.residual(model, trial)
             stalled = 0 if current <= 0.5 * best else stalled + 1
             best = min(best, current)
+            bests.append(best)
         final = backend.residual(model, trial)
-        if not (final <= tol * tol or (stalled >= STALL and final < tol)):
+        if not (final <= tol * tol or (stuck and final < tol)):
             return None
         return trial if backend.wells_hold(model, trial) else None
