@@ -9,8 +9,8 @@ import pytest
 
 from stickslip import registry
 from stickslip.events.results import read_analysis_file
-from stickslip.formats.fem_run import read_increments
 from stickslip.formats.event_table import read_slip_events
+from stickslip.formats.fem_run import read_increments
 from stickslip.lineage import Artifact
 from stickslip.params import parse_params
 

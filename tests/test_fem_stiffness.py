@@ -5,8 +5,8 @@ import math
 import pytest
 
 from stickslip import registry
-from stickslip.formats.fem_run import describe, read_run_attrs
 from stickslip.fem.stiffness import PHI_STIFF, at_paper_phi, driving_regime, stiffness_ratio
+from stickslip.formats.fem_run import describe, read_run_attrs
 from stickslip.mesh.rows import plate_target_height
 from stickslip.params import parse_params
 

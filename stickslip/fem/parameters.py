@@ -9,6 +9,8 @@ import dataclasses
 
 from ..formats import fem_run
 from ..params import ParameterError, param, parse_params
+from .backends import BACKENDS, DEFAULT_BACKEND
+from .laws import INTERFACE_LAWS
 
 __all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "stored_params"]
 
@@ -72,6 +74,12 @@ class FemParams:
     lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",
                                 unit="H_1 - H_0 (mid-height distance of layers 1 and 0)", exclusive_minimum=0.0)
     max_increments: int = param(0, "stop after this many increments (0: run until the margin stop)", minimum=0)
+    interface_law: str = param("cusp", "potential of the interface blocks in a well: 'cusp' (parabolas joined by "
+                                       "cusps, the paper's) or 'smooth' (wells joined smoothly; docs/fem.md)",
+                               choices=INTERFACE_LAWS, extension=True)
+    backend: str = param(DEFAULT_BACKEND, "how the numbers are computed: 'structured' (stencil kernels, default) "
+                                          "or 'assembled' (the CSR reference; other round-off, so its own run id)",
+                         choices=tuple(BACKENDS), extension=True)
 
     def check(self):
         """Check conditions across fields."""

@@ -11,6 +11,7 @@ import pandas as pd
 
 from ..formats.fem_run import RunFile
 from ..h5io import FileFormatError, open_file
+from .backends import make_backend
 from .parameters import stored_params
 from .system import System
 
@@ -24,6 +25,9 @@ class EventReplay:
     ----------
     path : str or os.PathLike
         A ``fem-run`` file.
+    backend : optional
+        How the numbers are computed (:mod:`.backends`); default: the run's own backend
+        (``params.backend``) with one thread, which reproduces the stored increments bit for bit.
 
     Notes
     -----
@@ -31,7 +35,7 @@ class EventReplay:
     stiffness) built, once; each :meth:`failures` costs one kick and one minimisation.
     """
 
-    def __init__(self, path):
+    def __init__(self, path, backend=None):
         self.path = path
         with open_file(path) as file:
             run = RunFile(file)
@@ -39,7 +43,7 @@ class EventReplay:
             table = run.increments()
             response = run.linear_response()
             self.N = run.mesh.N
-            self.system = System(self.params, run.mesh)
+            self.system = System(self.params, run.mesh, backend or make_backend(self.params.backend))
         self._kick = table["kick"].to_numpy(dtype=bool)
         self._yield_element = table["yield_element"].to_numpy(dtype=bool)
         self.system.set_linear_response(*response)
