@@ -20,7 +20,7 @@ from stickslip.experiment.virtual.slab_dynamics import SlabDynamics, Trajectory
 from stickslip.experiment.virtual.slab_equations import rhs
 from stickslip.experiment.virtual.slab_linear_system import factorize, new_factors, solve
 from stickslip.params import parse_params
-from stickslip.solvers import rate_state_lever
+from stickslip.experiment.virtual import rate_state_model
 
 N, H, h = 49.0, 100.0, 10.0
 LAW = RateStateLaw(a=np.full(5, 0.013), b=np.full(5, 0.019), D_c=np.full(5, 5e-4), mu0=np.full(5, 0.35), V0=1e-3)
@@ -200,7 +200,7 @@ def test_the_default_tolerance_resolves_the_slips_to_the_sensor_resolution():
     (force noise: 0.002 in mu; camera noise: 0.002 mm)."""
     plugin = registry.get("solver", "rate-state-lever")
     values = {"protocol": "individual", "n": 1, "a": 1, "duration": 1500.0}
-    default, reference = (rate_state_lever.simulate(parse_params(plugin.params, dict(values, rtol=rtol)))[1]
+    default, reference = (rate_state_model.simulate(parse_params(plugin.params, dict(values, rtol=rtol)))[1]
                           for rtol in (1e-4, 1e-8))
     assert len(default) == len(reference) >= 5
     for column, tolerance in (("t_start", 0.02), ("dmu", 1e-4), ("dR", 1e-4)):
@@ -248,7 +248,7 @@ def test_the_fallback_deep_in_a_stick_keeps_the_slips_of_a_tight_reference(tmp_p
 
     plugin = registry.get("solver", "rate-state-lever")
     params = parse_params(plugin.params, {"n": 5, "seed": 5, "duration": 700.0})
-    dynamics, R0, y0 = rate_state_lever.dynamics_of(params)
+    dynamics, R0, y0 = rate_state_model.dynamics_of(params)
     apparatus = dynamics.apparatus
     run = dynamics.integrate(y0, 700.0, apparatus.shear_rate)
     assert run.fallback_spans.tolist() == [[start, end]] and run.t.size - 1 == integration["steps"]
@@ -273,7 +273,7 @@ def test_the_fallback_deep_in_a_stick_keeps_the_slips_of_a_tight_reference(tmp_p
         friction = dynamics.friction(trajectory.y[after, 5:10], trajectory.y[after, 10:15], trajectory.y[after, :5])
         np.testing.assert_allclose(friction, statics, rtol=0, atol=1e-5)
 
-    slips, expected = (rate_state_lever.ground_truth(params, dynamics, R0, trajectory)[0] for trajectory in
+    slips, expected = (rate_state_model.ground_truth(params, dynamics, R0, trajectory)[0] for trajectory in
                        (run, reference))
     slips, expected = slips[slips["t_start"] > start], expected[expected["t_start"] > start]
     assert len(slips) == len(expected) >= 2 and list(slips["a"]) == list(expected["a"])

@@ -16,7 +16,7 @@ from stickslip.experiment.virtual.slab_dynamics import SlabDynamics
 from stickslip.experiment.virtual.slab_linear_system import factorize, new_factors, solve
 from stickslip.experiment.virtual.slip_path import PathProfiles, level, path_stream, random_profiles
 from stickslip.params import parse_params
-from stickslip.solvers import rate_state_lever
+from stickslip.experiment.virtual import rate_state_model
 
 N, H, h = 49.0, 100.0, 10.0
 ELL = 0.025  # [mm]
@@ -166,7 +166,7 @@ def test_steady_sliding_over_a_heterogeneous_path_averages_to_mu_ss_with_the_imp
 
 def _individual(epsilon, seed=1, duration=3000.0):
     values = dict(protocol="individual", n=1, a=1, duration=duration, seed=seed, path_disorder=epsilon)
-    _, truth, _, _ = rate_state_lever.simulate(parse_params(PLUGIN.params, values))
+    _, truth, _, _ = rate_state_model.simulate(parse_params(PLUGIN.params, values))
     return truth[truth["t_start"] > 300.0]
 
 
