@@ -11,8 +11,8 @@ docs/experiment-model-rate-state.md. The run is assembled from the parameters in
 in, time-series file out.
 
 Output: the experimental time-series file with the attributes ``params`` (JSON), ``seed``, ``solver``,
-``solver_version``, ``integration`` (JSON: ``method``, accepted ``steps``, ``fallback`` and
-``fallback_spans``, see :func:`stickslip.experiment.virtual.rate_state_model.simulate`) and two ground-truth tables: ``truth`` (one row per interface per slip, see
+``solver_version``, ``integration`` (JSON: ``method``, ``state``, accepted ``steps``, see
+:func:`stickslip.experiment.virtual.rate_state_model.simulate`) and two ground-truth tables: ``truth`` (one row per interface per slip, see
 :func:`stickslip.experiment.virtual.slip_intervals.slip_intervals`) and ``interfaces`` (one row per
 interface: ``a``, ``slippable``, ``a_rs``, ``b``, ``D_c`` [mm], ``mu0``, ``K_c`` [N/mm] (linear-stability
 boundary ``N (b - a) / D_c``), ``n_slips``, ``slip_total``, ``creep_total`` (``R_total - slip_total``),
@@ -30,7 +30,7 @@ from .lever import LeverParams, check_protocol
 
 __all__ = ["RateStateLeverParams", "run", "VERSION"]
 
-VERSION = "2"  # 2: RODAS4 with relative slip-rate tolerances (issue 12, third session)
+VERSION = "3"  # 2: RODAS4 with relative slip-rate tolerances (issue 12); 3: the friction as state (issue 24)
 
 #: Parameters shared with the ``lever`` solver: apparatus, protocol, drive, sensors.
 SHARED = ("n", "protocol", "a", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",
@@ -71,7 +71,7 @@ _OWN = [
                                    exclusive_minimum=0)),
     ("method", str, param(DEFAULT_METHOD, "implicit integrator (RODAS4: compiled Rosenbrock; others: scipy solve_ivp)",
                           choices=METHODS)),
-    ("rtol", float, param(1e-4, "relative tolerance of the integrator (the absolute tolerances scale with it)",
+    ("rtol", float, param(1e-5, "relative tolerance of the integrator (the absolute tolerances scale with it)",
                           exclusive_minimum=0)),
 ]
 

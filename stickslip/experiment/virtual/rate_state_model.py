@@ -16,11 +16,14 @@ from scipy.interpolate import CubicHermiteSpline
 
 from .model import apparatus as apparatus_of, per_interface, random_streams, sensor_signals
 from .rate_state import RateStateLaw
-from .slab_dynamics import FALLBACK, SlabDynamics
+from .slab_dynamics import SlabDynamics
 from .slip_intervals import slip_intervals
 from .slip_path import PathProfiles
 
-__all__ = ["law_of", "dynamics_of", "ground_truth", "simulate"]
+__all__ = ["STATE", "law_of", "dynamics_of", "ground_truth", "simulate"]
+
+#: The integrated variables, as recorded in a run's ``integration`` attribute (:mod:`.slab_equations`).
+STATE = "R, mu, psi, gamma"
 
 
 def law_of(params):
@@ -81,7 +84,7 @@ def ground_truth(params, dynamics, R0, trajectory):
 
     law = dynamics.law
     V = np.zeros((t.size, params.n_slabs))
-    V[:, index] = y[:, m:2 * m]
+    V[:, index] = dydt[:, :m]
     theta = np.zeros((t.size, params.n_slabs))
     theta[:, index] = law.D_c[index] / law.V0 * np.exp(y[:, 2 * m:3 * m])
     return slip_intervals(dynamics.apparatus, t, slips_at, V, theta, params.slip_velocity), slips_at
@@ -100,9 +103,8 @@ def simulate(params):
         The sensor signals and the ground truth, as from the ``lever`` solver's
         :func:`~stickslip.experiment.virtual.model.simulate` (the tables' columns: module docstring).
     integration : dict
-        How the run was integrated: ``method``, ``steps`` (accepted steps, int), ``fallback`` (the
-        method that takes over where ``method``'s step size underflows) and ``fallback_spans`` (start
-        and end [s] of every span it integrated: a list of pairs, empty for nearly every run).
+        How the run was integrated: ``method``, ``state`` (the integrated variables, "R, mu, psi,
+        gamma"), ``steps`` (accepted steps, int).
     """
     dynamics, R0, y0 = dynamics_of(params)
     apparatus, law = dynamics.apparatus, dynamics.law
@@ -121,6 +123,5 @@ def simulate(params):
                                "mu0": law.mu0, "K_c": law.critical_stiffness(params.normal_force),
                                "n_slips": slips["size"].to_numpy(np.int64), "slip_total": slips["sum"].to_numpy(float),
                                "creep_total": R_total - slips["sum"].to_numpy(float), "R_total": R_total})
-    integration = {"method": params.method, "steps": int(trajectory.t.size - 1), "fallback": FALLBACK,
-                   "fallback_spans": trajectory.fallback_spans.tolist()}
+    integration = {"method": params.method, "state": STATE, "steps": int(trajectory.t.size - 1)}
     return signals, truth, interfaces, integration
