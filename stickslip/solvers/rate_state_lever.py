@@ -11,10 +11,11 @@ docs/experiment-model-rate-state.md. The run is assembled from the parameters in
 in, time-series file out.
 
 Output: the experimental time-series file with the attributes ``params`` (JSON), ``seed``, ``solver``,
-``solver_version``, ``integration`` (JSON: ``method``, ``state``, accepted ``steps``, see
+``solver_version``, ``slab_order`` (JSON list of n_slabs ints: the physical slab at each position from the
+bottom, 1..n_slabs in order unless shuffled), ``integration`` (JSON: ``method``, ``state``, accepted ``steps``, see
 :func:`stickslip.experiment.virtual.rate_state_model.simulate`) and two ground-truth tables: ``truth`` (one row per interface per slip, see
 :func:`stickslip.experiment.virtual.slip_intervals.slip_intervals`) and ``interfaces`` (one row per
-interface: ``a``, ``slippable``, ``a_rs``, ``b``, ``D_c`` [mm], ``mu0``, ``K_c`` [N/mm] (linear-stability
+interface (position from the bottom): ``a``, ``slab`` (the physical slab there), ``slippable``, ``a_rs``, ``b``, ``D_c`` [mm], ``mu0``, ``K_c`` [N/mm] (linear-stability
 boundary ``N (b - a) / D_c``), ``n_slips``, ``slip_total``, ``creep_total`` (``R_total - slip_total``),
 ``R_total`` [mm]).
 """
@@ -23,7 +24,7 @@ import dataclasses
 
 from .. import registry
 from ..experiment.timeseries import write_timeseries
-from ..experiment.virtual.rate_state_model import simulate
+from ..experiment.virtual.rate_state_model import simulate, slab_order
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS
 from ..params import ParameterError, param, params_to_dict
 from .lever import LeverParams, check_protocol
@@ -62,6 +63,10 @@ _OWN = [
                                    minimum=0)),
     ("path_correlation_length", float, param(0.025, "correlation length of mu0 along the slip path (the paper's "
                                                     "asperity size)", unit="mm", minimum=0.001, maximum=1.0)),
+    ("slab_order", tuple[int, ...], param((), "physical slab at each position from the bottom, a permutation of "
+                                               "1..n_slabs (empty: in order); each slab's interface parameters, "
+                                               "quenched disorder and slip path travel with it (the paper's shuffled "
+                                               "control: 4,3,2,1,5)", minimum=1)),
     ("slab_mass", float, param(0.143, "mass of one slab (PMMA 10 x 150 x 80 mm)", unit="kg", exclusive_minimum=0)),
     ("load_mass", float, param(5.0, "dead weight on the top slab", unit="kg", minimum=0)),
     ("theta_start", float, param(0.01, "contact age of every interface at t = 0 (just slipped)", unit="s",
@@ -77,8 +82,11 @@ _OWN = [
 
 
 def _check(self):
-    """Check the protocol, the per-interface lengths and that every slippable interface weakens."""
+    """Check the protocol, the slab order and the per-interface lengths."""
     check_protocol(self)
+    if self.slab_order and sorted(self.slab_order) != list(range(1, self.n_slabs + 1)):
+        raise ParameterError(f"parameter 'slab_order': expected a permutation of 1..n_slabs={self.n_slabs} "
+                             f"(or nothing), got {list(self.slab_order)}")
     for name in PER_INTERFACE:
         if len(getattr(self, name)) not in (1, self.n_slabs):
             raise ParameterError(f"parameter '{name}': expected 1 or n_slabs={self.n_slabs} values, "
@@ -99,5 +107,6 @@ def run(params, output, *, threads, inputs):
     signals, truth, interfaces, integration = simulate(params)
     write_timeseries(output, signals, attrs={"params": params_to_dict(params), "seed": params.seed,
                                              "solver": "rate-state-lever", "solver_version": VERSION,
-                                             "integration": integration},
+                                             "integration": integration,
+                                             "slab_order": [int(slab) + 1 for slab in slab_order(params)]},
                      tables={"truth": truth, "interfaces": interfaces})

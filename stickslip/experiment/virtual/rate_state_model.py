@@ -20,24 +20,38 @@ from .slab_dynamics import SlabDynamics
 from .slip_intervals import slip_intervals
 from .slip_path import PathProfiles
 
-__all__ = ["STATE", "law_of", "dynamics_of", "ground_truth", "simulate"]
+__all__ = ["STATE", "slab_order", "law_of", "dynamics_of", "ground_truth", "simulate"]
 
 #: The integrated variables, as recorded in a run's ``integration`` attribute (:mod:`.slab_equations`).
 STATE = "R, mu, psi, gamma"
 
 
+def slab_order(params):
+    """0-based index of the physical slab at every position from the bottom, int [n_slabs]:
+    ``params.slab_order - 1``, or ``0 .. n_slabs - 1`` (in order) if it is empty."""
+    order = np.asarray(params.slab_order, dtype=int) - 1 if params.slab_order else np.arange(params.n_slabs)
+    return order
+
+
 def law_of(params):
     """The :class:`RateStateLaw` of a run: the per-interface values with the seed's quenched disorder
     (``b`` and ``D_c`` multiplied by ``exp(disorder xi - disorder^2 / 2)``, ``xi`` standard normal,
-    drawn from the disorder stream of :func:`~stickslip.experiment.virtual.model.random_streams`)."""
+    drawn from the disorder stream of :func:`~stickslip.experiment.virtual.model.random_streams`).
+
+    The values and the draws belong to the physical slabs (interface ``s`` is the one slab ``s`` slides
+    on): with a shuffled ``slab_order`` they travel with their slab to its position (:func:`slab_order`),
+    and every array of the law is indexed by position."""
     rng, _ = random_streams(params)
     spread = np.exp(params.disorder * rng.standard_normal((2, params.n_slabs)) - params.disorder ** 2 / 2)
-    return RateStateLaw(a=per_interface(params, "rs_a"), b=per_interface(params, "rs_b") * spread[0],
-                        D_c=per_interface(params, "D_c") * spread[1], mu0=per_interface(params, "mu0"), V0=params.V0)
+    order = slab_order(params)
+    return RateStateLaw(a=per_interface(params, "rs_a")[order], b=(per_interface(params, "rs_b") * spread[0])[order],
+                        D_c=(per_interface(params, "D_c") * spread[1])[order], mu0=per_interface(params, "mu0")[order],
+                        V0=params.V0)
 
 
 def dynamics_of(params):
-    """The equations of motion of a run and its initial state.
+    """The equations of motion of a run and its initial state (the slip-path profiles, like the law,
+    travel with their slab: :func:`law_of`).
 
     Returns
     -------
@@ -48,7 +62,7 @@ def dynamics_of(params):
         Initial state of the integration, [3 m + 1] (:meth:`SlabDynamics.initial_state`).
     """
     path = (PathProfiles.draw(params.seed, params.n_slabs, params.path_disorder, params.path_correlation_length)
-            if params.path_disorder > 0 else None)
+            .reordered(slab_order(params)) if params.path_disorder > 0 else None)
     dynamics = SlabDynamics(apparatus_of(params), law_of(params), params.slab_mass, params.load_mass, path=path)
     R0, y0 = dynamics.initial_state(params.V_start, params.theta_start, params.gamma_start)
     return dataclasses.replace(dynamics, path_origin=y0[:dynamics.interfaces.size]), R0, y0
@@ -119,7 +133,8 @@ def simulate(params):
     slips = truth.groupby("a")["dR"].agg(["size", "sum"]).reindex(a, fill_value=0)
     ends = slips_at(np.array([0.0, params.duration]))
     R_total = ends[1] - ends[0]
-    interfaces = pd.DataFrame({"a": a, "slippable": slippable, "a_rs": law.a, "b": law.b, "D_c": law.D_c,
+    interfaces = pd.DataFrame({"a": a, "slab": slab_order(params) + 1, "slippable": slippable, "a_rs": law.a,
+                               "b": law.b, "D_c": law.D_c,
                                "mu0": law.mu0, "K_c": law.critical_stiffness(params.normal_force),
                                "n_slips": slips["size"].to_numpy(np.int64), "slip_total": slips["sum"].to_numpy(float),
                                "creep_total": R_total - slips["sum"].to_numpy(float), "R_total": R_total})

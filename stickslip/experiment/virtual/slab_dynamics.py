@@ -302,7 +302,7 @@ class SlabDynamics:
         and ``atol`` per component. Returns a :class:`Trajectory`."""
         args = (rate, *self._arrays())
         method = rosenbrock.TABLEAUX[name].arrays()
-        t_now, y_now, h, steps = 0.0, y0, (rosenbrock.FIRST_STEP, 0.0, 1.0), 0
+        t_now, y_now, h, steps = 0.0, y0, rosenbrock.START, 0
         ts, ys, fs = [np.array([0.0])], [y0[None, :]], [self.rhs(y0, rate)[None, :]]
         for k in range(1, PROGRESS_PIECES + 1):
             t_pause = duration * k / PROGRESS_PIECES

@@ -101,6 +101,12 @@ class PathProfiles:
         values, slopes, spacing = random_profiles(path_stream(seed), n_slabs, correlation_length)
         return cls(float(relative_amplitude), values, slopes, spacing)
 
+    def reordered(self, order):
+        """The profiles with row ``i`` taken from row ``order[i]`` (int [n_slabs]; a shuffled stack,
+        whose surfaces travel with their slabs)."""
+        order = np.asarray(order, dtype=int)
+        return dataclasses.replace(self, values=self.values[order], slopes=self.slopes[order])
+
     def arguments(self, interfaces, mu0, origin):
         """The ``path`` argument of the compiled code (:func:`slip_path`) for the 0-based ``interfaces``
         [m] with the steady friction ``mu0`` [m] at the start and the slips ``origin`` [m] [mm] where
