@@ -37,7 +37,7 @@ BOUND = (0.3 - 0.15) / 4
 def slips(values):
     """Single slips after the transient, with B_a."""
     truth = simulate(parse_params(RateStateLeverParams, values))[1]
-    truth = truth[~truth["multi"] & (truth["t_start"] > TRANSIENT)].copy()
+    truth = truth[~truth["multi"] & (truth["t_start"] > TRANSIENT) & truth["T"].notna()].copy()
     truth["B_a"] = aging_rate(truth["dmu"], truth["T"])
     return truth
 

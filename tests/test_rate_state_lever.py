@@ -390,3 +390,19 @@ def test_the_integration_does_not_depend_on_where_time_starts():
     (t_zero, y_zero), (t_late, y_late) = ends
     assert np.diff(t_zero).min() < np.spacing(1e9) and t_late.size < t_zero.size
     assert np.array_equal(y_zero[-1], y_late[-1])
+
+
+def test_the_ground_truths_hermite_interpolant_equals_scipys():
+    """rate_state_model.hermite (numpy, so that a job need not import scipy.interpolate) equals
+    scipy's CubicHermiteSpline to 1e-12 on random data, and reproduces a cubic exactly."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    rng = np.random.default_rng(0)
+    t = np.cumsum(rng.random(50))
+    values, slopes = rng.random((50, 3)), rng.random((50, 3))
+    times = np.linspace(t[0], t[-1], 1000)
+    np.testing.assert_allclose(rate_state_model.hermite(t, values, slopes)(times),
+                               CubicHermiteSpline(t, values, slopes, axis=0)(times), rtol=0, atol=1e-12)
+    cubic = (t ** 3 - 2 * t)[:, None]
+    np.testing.assert_allclose(rate_state_model.hermite(t, cubic, (3 * t ** 2 - 2)[:, None])(times)[:, 0],
+                               times ** 3 - 2 * times, rtol=1e-12)

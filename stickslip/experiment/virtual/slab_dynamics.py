@@ -35,7 +35,6 @@ import sys
 from typing import NamedTuple
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ... import progress
 from . import rosenbrock
@@ -282,7 +281,9 @@ class SlabDynamics:
             return self._integrate_scipy(method, y0, duration, rate, rtol, absolute, clock)
 
     def _integrate_scipy(self, method, y0, duration, rate, rtol, atol, clock):
-        """``scipy.integrate.solve_ivp`` with ``method`` over ``duration`` [s]: a :class:`Trajectory`."""
+        """``scipy.integrate.solve_ivp`` with ``method`` over ``duration`` [s]: a :class:`Trajectory`
+        (scipy.integrate is imported here, not with the module: the default jobs never need it)."""
+        from scipy.integrate import solve_ivp
 
         def rhs(t, y):
             clock.at(t, None)
