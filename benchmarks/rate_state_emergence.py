@@ -15,7 +15,7 @@ deviation, sqrt(N) for a count; over seeds for R_slow):
 - the aging fit (origin and free intercept) on all stack slips, and per n;
 - mean and standard deviation of B_a per interface and n, the latter normalised by n = 1; and the
   standard deviation within one seed (the paper's situation: one apparatus), median over the seeds,
-  normalised by the individual protocol's (seed 1);
+  normalised by the same of the individual protocol;
 - R_slow per interface and n, and with the slabs shuffled (the runs with a ``slab_order`` are left out
   of everything else);
 - slips in multi-slip events.
@@ -116,9 +116,9 @@ def main(study):
                  f"+-{r.std_normalised_error:.2f}x, N={r.count})" for r in rows.itertuples()]
         print(f"  a={a}: " + "  ".join(cells))
 
-    print("\nstd(B_a) within one seed: median over the seeds per a and n (stack), normalised by the individual"
-          " protocol's (n = 1)")
-    individual = table[table["protocol"] == "individual"].groupby("a")["B_a"].std()
+    print("\nstd(B_a) within one seed (one apparatus: the seeds' quenched disorder left out): median over the seeds "
+          "per a and n, normalised by that of the individual protocol (n = 1, also within one seed)")
+    individual = table[table["protocol"] == "individual"].groupby(["a", "seed"])["B_a"].std().groupby("a").median()
     for a, part in table[table["protocol"] == "stack"].groupby("a"):
         cells = [f"n={n}: {g.groupby('seed')['B_a'].std().median():.4f}"
                  f" ({g.groupby('seed')['B_a'].std().median() / individual.get(a, np.nan):.1f}x)"

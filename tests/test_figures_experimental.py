@@ -164,7 +164,7 @@ def test_fig6_spread_median_run_and_standard_errors(study):
     interfaces = experimental_data.load_interfaces(study[experimental_data.EVENTS])
     runs = interfaces[(interfaces["protocol"] == "stack") & (interfaces["n"] == 5) & (interfaces["a"] == 2)]
     note = next(text.get_text() for text in example.texts if "median" in text.get_text())
-    shown = float(re.search(r": (-?[0-9.]+) \(", note)[1])
+    shown = float(re.search(r": (-?[0-9.]+)\s+\(", note)[1])
     assert shown == pytest.approx(np.sort(runs["R_slow"].to_numpy())[(len(runs) - 1) // 2], abs=5e-4)
     one = interfaces[(interfaces["protocol"] == "stack") & (interfaces["a"] == 1)].groupby("n")["R_slow"]
     bars = fraction.containers[0]                  # interface 1, n = 1..5
@@ -213,3 +213,33 @@ def test_si_n1_references_are_distributions(study, name):
     else:
         for ax in fig.axes[:4]:
             assert _density_std(_line(ax, "reference")) > WIDTH_FLOOR
+
+
+@pytest.mark.slow
+def test_figs_aging_recovery_plots_the_fits_of_each_pair(tmp_path):
+    """Two twins at fixed a = 0.013 (b = 0.019 and 0.025; stacks n = 3..5, seed 1, 3000 s): (a) plots
+    for each pair the fit through the origin and with an intercept of its stack slips at its b (the
+    pair at b - a = 0.006 in both series); the origin fit grows with b - a at fixed a (measured over 3
+    seeds: 0.053 -> 0.089)."""
+    solver, analysis = registry.get("solver", "rate-state-lever"), registry.get("analysis", "experiment-events")
+    events = []
+    for rs_b in (0.019, 0.025):
+        for n in (3, 4, 5):
+            params = parse_params(solver.params, {"n": n, "seed": 1, "duration": 3000.0, "path_disorder": 0.02,
+                                                  "rs_a": 0.013, "rs_b": rs_b})
+            raw = Artifact(tmp_path / f"raw{rs_b}-{n}.h5", registry.run_id(solver, params), solver.name, solver.produces)
+            solver.run(params, raw.path, threads=1, inputs={})
+            item = Artifact(tmp_path / f"events{rs_b}-{n}.h5", registry.derived_run_id(analysis, analysis.params(),
+                                                                                      [raw.run_id]),
+                            analysis.name, analysis.produces, raw)
+            analysis.run(analysis.params(), raw, item.path)
+            events.append(item)
+    fig = _draw("figS-aging-recovery", {experimental_data.EVENTS: events})
+    plotted = {container.lines[0].get_gid(): container for container in fig.axes[0].containers}
+    at_a = plotted["B_origin:a"].lines[0]
+    x, y = (np.asarray(values, dtype=float) for values in at_a.get_data())
+    np.testing.assert_allclose(x, [0.019 + 0.0003, 0.025 + 0.0003])
+    errors = np.array([s[1, 1] - s[0, 1] for s in plotted["B_origin:a"].lines[2][0].get_segments()]) / 2
+    assert y[1] - y[0] > 3 * np.hypot(*errors)
+    assert plotted["B_origin:difference"].lines[0].get_xdata()[0] == pytest.approx(0.019)
+    assert "B_intercept:a" in plotted and "B_intercept:difference" in plotted

@@ -93,7 +93,7 @@ def draw(params, inputs):
     spread_panel(axes[0, 1], slips)
     seed = run_slips["seed"].iloc[0] if "seed" in run_slips.columns and len(run_slips) else None
     note = (f"$n = {params.n_example}$, median $R_\\mathrm{{slow}}$ of $a = {params.a_example}$: "
-            f"{R_slow:.3f} ({rank} of {count} runs" + (f", seed {seed})" if seed is not None else ")"))
+            f"{R_slow:.3f}\n({rank} of {count} runs" + (f", seed {seed})" if seed is not None else ")"))
     slow_slip_example(axes[1, 0], record, run_slips, params.a_example, params.duration, note)
     slow_slip_fraction_panel(axes[1, 1], interfaces)
     legend_outside(axes[1, 1])

@@ -56,8 +56,8 @@ def draw(params, inputs):
         axes[0].plot(record.t_x[window][marked], R[marked, a - 1] - R[0, a - 1], linestyle="none", marker=".",
                      markersize=2.5, color="black")
     axes[0].plot([], [], linestyle="none", marker=".", color="black", label="slip frames")
-    axes[0].text(0.98, 0.03, f"$n = {record.n}$, median $R_\\mathrm{{slow}}$ of $a = {params.a_example}$: "
-                 f"{R_slow:.3f}\n({rank} of {count} runs)", transform=axes[0].transAxes, ha="right", va="bottom",
+    axes[0].text(0.02, 0.97, f"$n = {record.n}$, median $R_\\mathrm{{slow}}$ of $a = {params.a_example}$: "
+                 f"{R_slow:.3f}\n({rank} of {count} runs)", transform=axes[0].transAxes, ha="left", va="top",
                  fontsize=6.5)
     legend_outside(axes[0])
     shown = (t_velocity >= t_range[0]) & (t_velocity <= t_range[1])
