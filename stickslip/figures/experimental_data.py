@@ -86,6 +86,14 @@ def load_interfaces(paths, *, shuffled=False):
     return _load(paths, "interfaces", shuffled)
 
 
+def _record_of(events, file):
+    """The time series that the ``experiment-events`` output ``file`` (one of ``events``) analysed."""
+    artifact = next(item for item in events if str(item) == file)
+    if artifact.parent is None:
+        raise h5io.FileFormatError(f"{file}: given without the time series it was made from (its lineage)")
+    return read_timeseries(artifact.parent)
+
+
 def example_run(slips, events, *, n, protocol="stack"):
     """The first run (sorted by seed, then path) with ``n`` and ``protocol``: its time series and slips.
 
@@ -113,10 +121,7 @@ def example_run(slips, events, *, n, protocol="stack"):
         raise h5io.FileFormatError(f"no {EVENTS} file with n = {n} and protocol '{protocol}' among the inputs")
     order = runs.sort_values([c for c in ("seed", "file") if c in runs.columns])
     chosen = order["file"].iloc[0]
-    artifact = next(item for item in events if str(item) == chosen)
-    if artifact.parent is None:
-        raise h5io.FileFormatError(f"{chosen}: given without the time series it was made from (its lineage)")
-    return read_timeseries(artifact.parent), runs[runs["file"] == chosen]
+    return _record_of(events, chosen), runs[runs["file"] == chosen]
 
 
 def median_run(interfaces, events, *, n, a):
@@ -148,10 +153,7 @@ def median_run(interfaces, events, *, n, a):
     ordered = runs.sort_values(["R_slow", "file"], kind="stable")
     middle = (len(ordered) - 1) // 2
     chosen = ordered.iloc[middle]
-    artifact = next(item for item in events if str(item) == chosen["file"])
-    if artifact.parent is None:
-        raise h5io.FileFormatError(f"{chosen['file']}: given without the time series it was made from (its lineage)")
-    return read_timeseries(artifact.parent), chosen["file"], float(chosen["R_slow"]), (middle + 1, len(ordered))
+    return _record_of(events, chosen["file"]), chosen["file"], float(chosen["R_slow"]), (middle + 1, len(ordered))
 
 
 def excerpt(record, t_from, duration):
