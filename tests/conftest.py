@@ -136,3 +136,23 @@ def ci_study():
     snakemake(directory, "--cores", "2", "--configfile", "workflow/config/ci.yaml")
     yield directory
     shutil.rmtree(directory, ignore_errors=True)
+
+
+@pytest.fixture
+def drawn_figures(monkeypatch):
+    """The matplotlib figures that a figure plugin saves during the test, in order (read their plotted data).
+
+    A plugin closes its figure after saving it (:func:`stickslip.figures.style.save_figure`); the
+    closed figure keeps its axes, lines and texts.
+    """
+    from matplotlib.figure import Figure
+
+    drawn, savefig = [], Figure.savefig
+
+    def recording_savefig(figure, *args, **kwargs):
+        if not any(figure is seen for seen in drawn):
+            drawn.append(figure)
+        return savefig(figure, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", recording_savefig)
+    return drawn

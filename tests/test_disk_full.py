@@ -17,8 +17,8 @@ from contextlib import contextmanager
 import pytest
 
 from stickslip import h5io
-from stickslip.fem.output import RunFile
 from stickslip.fem.run import FREE_SPACE_MARGIN
+from stickslip.formats.fem_run import RunFile
 
 LEVER = ["simulate", "--solver", "lever", "--param", "n=2", "--param", "duration=600"]
 

@@ -17,7 +17,7 @@ import pytest
 
 from conftest import FEM_REFERENCE_CASE
 from stickslip.cli import main
-from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError, UnreadableFileError
 from stickslip.workflow_api import partial_path
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from stickslip import registry
-from stickslip.fem.output import read_run_attrs
 from stickslip.fem.yield_strains import HeldYieldStrains, interface_initstate, narrowest_well, yield_strains
+from stickslip.formats.fem_run import read_run_attrs
 from stickslip.h5io import read_table
 from stickslip.params import parse_params
 

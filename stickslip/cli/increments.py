@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from ..fem.output import read_increments
+from ..formats.fem_run import read_increments
 
 
 def add_parser(subparsers):

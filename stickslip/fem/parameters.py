@@ -7,11 +7,12 @@ dimensionless. See docs/fem.md and shared/reference-model.md (section 11).
 
 import dataclasses
 
-from ..params import ParameterError, param
+from ..formats import fem_run
+from ..params import ParameterError, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS
 
-__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS"]
+__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "stored_params"]
 
 #: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
 DRIVES = ("fixed-lever", "free-lever")
@@ -88,3 +89,20 @@ class FemParams:
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
+
+
+def stored_params(file):
+    """The :class:`FemParams` of an open ``fem-run`` file (stored there as the producer's opaque JSON).
+
+    Parameters
+    ----------
+    file : h5py.File
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the file is not a ``fem-run`` file of the current version.
+    stickslip.params.ParameterError
+        If its parameters are not those of a :class:`FemParams`.
+    """
+    return parse_params(FemParams, fem_run.read_params(file), owner=f"{file.filename}: params")

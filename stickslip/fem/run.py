@@ -23,11 +23,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
+from ..formats.fem_run import RunFile, append_increment, create_file, rewrite
 from ..h5io import FileFormatError, UnreadableFileError, atomic_output, check_free_space, open_file, writer_lock
 from ..params import params_to_dict
 from .minimise import within_margin
 from .observables import Observer, observable_columns
-from .output import RunFile, append_increment, create_file, read_params, rewrite
+from .parameters import stored_params
 from .stiffness import driving_regime, stiffness_ratio
 from .system import System
 
@@ -70,7 +71,7 @@ class _Progress:
 
 
 def _header(system, observer, producer):
-    """Root attributes of the run file: the producing solver, parameters, normalisation."""
+    """Root attributes of the run file: the fields of :data:`stickslip.formats.fem_run.HEADER`, then ``fem``'s own."""
     p, c = system.params, system.constants
     phi = stiffness_ratio(p.k_drive, p.N, p.G)
     return {"solver": producer[0], "solver_version": producer[1], "params": params_to_dict(p),
@@ -104,7 +105,7 @@ def _stored(output, params):
         return None
     try:
         with open_file(output) as file:
-            stored = read_params(file)
+            stored = stored_params(file)
             completed = bool(file.attrs["completed"])
     except UnreadableFileError as error:
         aside = _aside(output)
@@ -132,7 +133,7 @@ def run_simulation(params, output, mesh, backend, *, producer):
     While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,
     e.g. by ``stickslip increments``), one committed increment at a time. However
     the run ends (an exception, SIGINT, SIGTERM, SIGKILL), the next call rewrites
-    the file from its committed increments (:func:`.output.rewrite`) and resumes;
+    the file from its committed increments (:func:`stickslip.formats.fem_run.rewrite`) and resumes;
     a file that HDF5 cannot open is moved aside with a message and the run starts
     over. A disk that fills up ends the run before an increment is written
     (:data:`FREE_SPACE_MARGIN`); it resumes when rerun with space. A finished run is rewritten once more, so that the file has the same bytes

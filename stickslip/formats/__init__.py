@@ -13,10 +13,10 @@ Built-in formats (``docs/developing.md`` draws the data flow):
 format         reader/writer                            producers -> consumers
 =============  =======================================  ========================================
 mesh           :mod:`stickslip.mesh.io`                 mesh stage -> ``fem`` (solver input), figS-mesh
-fem-run        :mod:`stickslip.fem.output`              ``fem`` -> numerical-events, front-dynamics
+fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics
 timeseries     :mod:`stickslip.experiment.timeseries`   ``lever``, lab CSV import -> experiment-events
 event-table    :mod:`stickslip.formats.event_table`     numerical-events, experiment-events -> figures, database
-front-table    :mod:`stickslip.events.fronts`           front-dynamics -> figS-event-maps, figS-tau
+front-table    :mod:`stickslip.formats.front_table`     front-dynamics -> figS-event-maps, figS-tau
 =============  =======================================  ========================================
 
 A simulation format says what kind of data it holds (``source``: "numerical" or
@@ -182,14 +182,14 @@ def describe(name, path):
 
 for _builtin in (
         Format("mesh", 1, "stickslip.mesh.io", "a layered Quad4 mesh (coordinates, connectivity, layers)"),
-        Format("fem-run", 1, "stickslip.fem.output", "a quasistatic finite-element run: header, mesh, linear "
+        Format("fem-run", 1, "stickslip.formats.fem_run", "a quasistatic finite-element run: header, mesh, linear "
                "response, one state and one row of observables per increment", source="numerical",
-               describe="stickslip.fem.output:describe"),
+               describe="stickslip.formats.fem_run:describe"),
         Format("timeseries", 1, "stickslip.experiment.timeseries", "an experimental recording: lever force F(t), "
                "slab positions x(t), apparatus attributes", source="experimental",
                describe="stickslip.experiment.timeseries:describe"),
         Format("event-table", 1, "stickslip.formats.event_table", "slip events: one row per (event, slipping "
                "interface) in the table 'slip_events', plus the analysis's own tables"),
-        Format("front-table", 1, "stickslip.events.fronts", "re-run events: block failures and rupture fronts"),
+        Format("front-table", 1, "stickslip.formats.front_table", "re-run events: block failures and rupture fronts"),
 ):
     register_format(_builtin)
