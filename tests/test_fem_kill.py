@@ -107,10 +107,10 @@ def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(fem_reference
 
 
 def test_a_file_another_process_writes_is_refused(tmp_path):
-    from stickslip.h5io import writer_lock
+    from stickslip.output_safety.lock import writer_lock
 
     output = tmp_path / "run.h5"
-    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from stickslip.h5io import writer_lock\n"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from stickslip.output_safety.lock import writer_lock\n"
                                f"with writer_lock({str(output)!r}):\n print('locked', flush=True); time.sleep(60)"],
                               stdout=subprocess.PIPE, text=True)
     try:

@@ -12,7 +12,8 @@ import argparse
 import importlib
 import sys
 
-from ..h5io import FileFormatError, OutputError
+from ..h5io import FileFormatError
+from ..output_safety.errors import OutputError
 from ..params import ParameterError
 from ..registry import PluginError
 from ..termination import exit_status, interruption, sigterm_as_interrupt

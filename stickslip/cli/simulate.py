@@ -4,8 +4,8 @@ import argparse
 from pathlib import Path
 
 from .. import registry
-from ..h5io import check_output
 from ..numba_options import set_num_threads
+from ..output_safety.atomic import check_output
 from ..params import parse_assignments, parse_params
 
 

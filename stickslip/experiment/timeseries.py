@@ -42,6 +42,7 @@ import dataclasses
 import numpy as np
 
 from .. import formats, h5io
+from ..output_safety.atomic import atomic_output
 
 __all__ = ["FORMAT", "PROTOCOLS", "ExperimentRecord", "write_timeseries", "read_timeseries", "read_truth",
            "validate_record", "describe"]
@@ -216,7 +217,7 @@ def write_timeseries(path, record, *, attrs=None, tables=None):
     clashes = sorted(reserved & (set(attrs or {}) | set(tables or {})))
     if clashes:
         raise ValueError(f"extra attributes/tables must not reuse the format's names: {', '.join(clashes)}")
-    with h5io.atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
+    with atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
         formats.stamp(f, FORMAT)
         for name in _DATASETS:
             h5io.write_dataset(f, name, np.asarray(getattr(record, name), dtype=np.float64), **_COMPRESSION)

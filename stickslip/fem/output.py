@@ -33,9 +33,9 @@ import json
 import numpy as np
 
 from .. import __version__, formats
-from ..h5io import (FileFormatError, atomic_output, copy_file, open_file, read_array, read_table, write_attrs,
-                    write_dataset)
+from ..h5io import FileFormatError, copy_file, open_file, read_array, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
+from ..output_safety.atomic import atomic_output
 from ..params import parse_params
 from .parameters import FemParams
 

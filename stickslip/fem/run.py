@@ -23,7 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
-from ..h5io import FileFormatError, UnreadableFileError, atomic_output, check_free_space, open_file, writer_lock
+from ..h5io import FileFormatError, UnreadableFileError, open_file
+from ..output_safety.atomic import atomic_output
+from ..output_safety.lock import writer_lock
+from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .minimise import within_margin
 from .observables import Observer, observable_columns
