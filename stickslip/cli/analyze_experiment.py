@@ -7,8 +7,10 @@ import pandas as pd
 from ..experiment.aging import FITS, fit_aging, fit_aging_per_interface
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
 from ..experiment.timeseries import read_timeseries
+from ..output_safety.overwrite import write_text_output
 from ..params import ParameterError, parse_assignments, parse_params
 from ..progress import iterate
+from . import add_overwrite_option
 
 
 def add_parser(subparsers):
@@ -21,7 +23,9 @@ def add_parser(subparsers):
                     "slips with a waiting time: through the origin (the paper's fit) or with a free intercept c "
                     "(dmu = c + B ln(T/T0)), over all interfaces or per interface.")
     parser.add_argument("runs", nargs="+", type=Path, metavar="RUN.h5", help="time-series files")
-    parser.add_argument("-o", "--output", type=Path, help="CSV file of the slips")
+    parser.add_argument("-o", "--output", type=Path,
+                        help="CSV file of the slips (an existing one with other content is refused)")
+    add_overwrite_option(parser)
     parser.add_argument("--aging", action="store_true",
                         help="fit the aging law; the last line printed is `B=<value> +- <error>` (origin) or "
                              "`B=<value> +- <error> c=<value> +- <error>` (intercept)")
@@ -48,8 +52,7 @@ def run(args):
         tables.append(slips.assign(run=str(path)))
     slips = pd.concat(tables, ignore_index=True)
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        slips.to_csv(args.output, index=False)
+        write_text_output(args.output, slips.to_csv(index=False), overwrite=args.overwrite)
         print(f"{len(slips)} slips ({int(slips['multi'].sum())} in multi-interface events) -> {args.output}")
     if args.aging:
         single = slips[~slips["multi"].to_numpy(dtype=bool)]

@@ -16,7 +16,6 @@ Reference: shared/reference-model.md, section 8c.
 """
 
 import json
-import os
 import sys
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from .. import progress
 from ..h5io import FileFormatError, UnreadableFileError, open_file
 from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
+from ..output_safety.overwrite import set_aside
 from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .minimise import within_margin
@@ -110,23 +110,12 @@ def _stored(output, params):
             stored = read_params(file)
             completed = bool(file.attrs["completed"])
     except UnreadableFileError as error:
-        aside = _aside(output)
-        os.replace(output, aside)
+        aside = set_aside(output, "unreadable")
         print(f"stickslip: {error}; moved it to {aside}, starting the run over", file=sys.stderr)
         return None
     if params_to_dict(stored) != params_to_dict(params):
         raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
     return completed
-
-
-def _aside(path):
-    """A free name ``<name>.unreadable[-<k>]`` beside ``path``."""
-    aside = path.with_name(f"{path.name}.unreadable")
-    k = 1
-    while aside.exists():
-        k += 1
-        aside = path.with_name(f"{path.name}.unreadable-{k}")
-    return aside
 
 
 def run_simulation(params, output, mesh, threads=1, *, producer):

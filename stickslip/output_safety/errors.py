@@ -14,8 +14,10 @@ class OutputError(OSError):
         The output file.
     code : int
         The ``errno`` of the failure.
+    reason : str, optional
+        The message after ``<path>: ``; default ``cannot write it (<strerror of code>)``.
     """
 
-    def __init__(self, path, code):
-        super().__init__(f"{path}: cannot write it ({os.strerror(code)})")
+    def __init__(self, path, code, reason=None):
+        super().__init__(f"{path}: {reason or f'cannot write it ({os.strerror(code)})'}")
         self.errno = code

@@ -86,3 +86,12 @@ onstart:
         # submitted jobs are cancelled (scancel). Snakemake's own SIGTERM handler waits for them instead, for
         # hours or, for a job that never starts, forever.
         raise_interrupt_on_sigterm()
+
+
+onsuccess:
+    # A completed simulation keeps a second name under sim/{solver}/partial/ until Snakemake has seen its job
+    # finish, so that a job that completed while Snakemake was stopped is not recomputed by the rerun
+    # (stickslip.workflow_api.run_simulation); after a successful run Snakemake has seen them all.
+    from stickslip.workflow_api import release_completed
+
+    release_completed(STUDY.root)
