@@ -7,7 +7,10 @@ the brink of yielding (odd increments), and a kick followed by minimisation
 redone so that a whole element yields (``yield_element``). The run stops, and
 is marked completed, when a block comes within ``margin`` wells of the end of
 its yield strains (during a minimisation, or after a load step), or after
-``max_increments`` increments. Every increment is appended and committed; a run
+``max_increments`` increments; with unbounded yield strains and ``max_increments``
+0, when an increment leaves a block within ``margin`` wells of the end of its
+first ``nchunk`` wells (where the paper's code stops; that increment is not
+stored). Every increment is appended and committed; a run
 ended in any way (exception, SIGINT, SIGTERM, SIGKILL) resumes from its last
 committed increment and gives the same file, byte for byte, as an uninterrupted
 run. Progress (increments, slip events so far, increments/s, time left when
@@ -185,6 +188,7 @@ def _increments(params, output, threads):
         reason = ""
         report = _Progress(file, params, increment)
         needed = 2 * run.increment_bytes() + FREE_SPACE_MARGIN
+        last_well = params.nchunk + 1 - params.margin if system.extend and not params.max_increments else None
         while not reason:
             if params.max_increments and increment >= params.max_increments:
                 reason = "max_increments"
@@ -202,6 +206,9 @@ def _increments(params, output, threads):
                 if not system.extend and not within_margin(system.model, system.state.idx, params.margin):
                     reason = "margin"
                     break
+            if last_well is not None and system.well_index().max() >= last_well:
+                reason = "margin"
+                break
             check_free_space(output, needed)
             append_increment(file, system.snapshot(), _row(observer, increment, kick, yield_element, previous_index))
             previous_index = observer.well_index()
