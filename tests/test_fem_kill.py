@@ -88,7 +88,7 @@ def test_a_killed_workflow_job_resumes_to_the_same_bytes(fem_reference_run, tmp_
         assert status != 0
         assert not output.exists() and partial.exists()
         assert signum != signal.SIGTERM or "terminated by SIGTERM" in log.read_text()
-    assert log.read_text().rstrip().endswith("KeyboardInterrupt")  # Ctrl-C
+    assert "KeyboardInterrupt" in log.read_text()  # Ctrl-C (wrapped in a SystemError if it came in a kernel)
     done = subprocess.run(_workflow_job(output), capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "resuming from" in log.read_text()

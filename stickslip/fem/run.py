@@ -209,7 +209,7 @@ def _increments(params, output, threads):
             if last_well is not None and system.well_index().max() >= last_well:
                 reason = "margin"
                 break
-            check_free_space(output, needed)
+            check_free_space(output, needed, FREE_SPACE_MARGIN)
             append_increment(file, system.snapshot(), _row(observer, increment, kick, yield_element, previous_index))
             previous_index = observer.well_index()
             new += 1

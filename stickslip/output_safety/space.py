@@ -9,7 +9,7 @@ from .errors import OutputError
 __all__ = ["check_free_space"]
 
 
-def check_free_space(path, nbytes):
+def check_free_space(path, nbytes, margin=0):
     """Raise OutputError (ENOSPC) unless the file system of ``path`` has ``nbytes`` free.
 
     For a writer that appends to an existing file in place, where a write that fails
@@ -23,11 +23,21 @@ def check_free_space(path, nbytes):
         The file appended to.
     nbytes : int
         Bytes needed [B].
+    margin : int, optional
+        Bytes of ``nbytes`` that are a safety margin, not data [B]: the message then says that the
+        disk is not full but kept from filling.
 
     Raises
     ------
     OutputError
-        If less is free (for unprivileged users).
+        If less is free (for unprivileged users); the message gives what is free and what is needed.
     """
-    if shutil.disk_usage(Path(path).parent).free < nbytes:
-        raise OutputError(path, errno.ENOSPC)
+    free = shutil.disk_usage(Path(path).parent).free
+    if free < nbytes:
+        kept = f", {_mib(margin)} of it a safety margin kept free: HDF5 crashes on a full disk" if margin else ""
+        raise OutputError(path, errno.ENOSPC, f"cannot write it: {_mib(free)} free, the next write needs "
+                                              f"{_mib(nbytes)}{kept}; free some space and rerun")
+
+
+def _mib(nbytes):
+    return f"{nbytes / 2**20:.2f} MiB"
