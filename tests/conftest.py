@@ -1,4 +1,4 @@
-"""Shared fixtures: the toy plugin distribution (entry points) and a workflow copy."""
+"""Shared fixtures: the toy plugin distribution (entry points) and a workflow copy; test groups for pytest-xdist."""
 
 import json
 import shutil
@@ -51,6 +51,27 @@ def toy_plugins(toy_distribution, monkeypatch):
     monkeypatch.syspath_prepend(str(toy_distribution))
     monkeypatch.setattr(registry, "_loaded", False)
     return toy_distribution
+
+
+#: Session fixtures too costly to make twice: the modules that use one run in one pytest-xdist worker.
+SHARED_FIXTURES = ("ci_study", "fem_reference_run")
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Put every test in the pytest-xdist group of its module (``--dist loadgroup``, as .ci/run runs the suite).
+
+    A module's tests then run in one worker, so its module fixtures are made once; the modules that use
+    one of :data:`SHARED_FIXTURES` share that fixture's group. Without pytest-xdist the marks do nothing.
+    """
+    modules = {}
+    for item in items:
+        shared = [name for name in SHARED_FIXTURES if name in item.fixturenames]
+        group = modules.setdefault(item.module.__name__, item.module.__name__)
+        if shared and group not in SHARED_FIXTURES:
+            modules[item.module.__name__] = shared[0]
+    for item in items:
+        item.add_marker(pytest.mark.xdist_group(modules[item.module.__name__]))
 
 
 def copy_workflow(destination):
