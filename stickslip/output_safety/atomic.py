@@ -88,28 +88,6 @@ def check_output(path):
         os.close(fd)
 
 
-def check_output(path):
-    """Raise now if ``path`` cannot be written, before a long computation would find it out.
-
-    Makes the missing directories and a temporary file beside ``path`` (removed again).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-
-    Raises
-    ------
-    OutputError
-        If ``path`` is a directory, or its directory cannot be made or written to.
-    """
-    path = Path(path)
-    with _output_errors(path):
-        _make_directory(path)
-        fd, tmp = _locked_temporary(path)
-        tmp.unlink()
-        os.close(fd)
-
-
 def _make_directory(path):
     """Make the directory of the output file ``path`` (IsADirectoryError if ``path`` is one)."""
     if path.is_dir():
