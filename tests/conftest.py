@@ -1,6 +1,7 @@
 """Shared fixtures: the toy plugin distribution (entry points) and a workflow copy; test groups for pytest-xdist."""
 
 import json
+import os
 import shutil
 import sys
 import tempfile
@@ -51,6 +52,23 @@ def toy_plugins(toy_distribution, monkeypatch):
     monkeypatch.syspath_prepend(str(toy_distribution))
     monkeypatch.setattr(registry, "_loaded", False)
     return toy_distribution
+
+
+@pytest.fixture(autouse=True)
+def numba_threads_variable():
+    """Restore ``NUMBA_NUM_THREADS`` after every test.
+
+    The workflow's job functions set it for their process (``workflow_api.prepare_environment``); in
+    the test process a changed value makes numba's next compilation fail ("Cannot set
+    NUMBA_NUM_THREADS to a different value once the threads have been launched"), in whichever test
+    of the same process (pytest-xdist worker) compiles next.
+    """
+    saved = os.environ.get("NUMBA_NUM_THREADS")
+    yield
+    if saved is None:
+        os.environ.pop("NUMBA_NUM_THREADS", None)
+    else:
+        os.environ["NUMBA_NUM_THREADS"] = saved
 
 
 #: Session fixtures too costly to make twice: the modules that use one run in one pytest-xdist worker.
