@@ -71,25 +71,38 @@ def numba_threads_variable():
         os.environ["NUMBA_NUM_THREADS"] = saved
 
 
-#: Session fixtures too costly to make twice: the modules that use one run in one pytest-xdist worker.
-SHARED_FIXTURES = ("ci_study", "fem_reference_run")
+#: Test modules that share a costly session fixture, by the fixture: pytest-xdist runs each set in one worker.
+SHARED = {"ci_study": ("test_workflow_smoke", "test_slurm", "test_docs_queries"),
+          "fem_reference_run": ("test_fem_reference", "test_fem_kill")}
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(config, items):
-    """Put every test in the pytest-xdist group of its module (``--dist loadgroup``, as .ci/run runs the suite).
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """CI's two workers (``pytest -n 2``, .ci/run): each test module runs in one worker, so its module fixtures
+    are made once, and the modules of one :data:`SHARED` set run in one worker, so its session fixture is too.
 
-    A module's tests then run in one worker, so its module fixtures are made once; the modules that use
-    one of :data:`SHARED_FIXTURES` share that fixture's group. Without pytest-xdist the marks do nothing.
+    (pytest-xdist's own ``--dist loadgroup`` groups nothing under pytest 9: it renames node ids through an
+    attribute pytest 9 no longer reads.)
     """
-    modules = {}
+    from xdist.scheduler import LoadScopeScheduling
+
+    groups = {module: fixture for fixture, modules in SHARED.items() for module in modules}
+
+    class ModuleGroups(LoadScopeScheduling):
+        def _split_scope(self, nodeid):
+            module = nodeid.split("::", 1)[0]
+            return groups.get(Path(module).stem, module)
+
+    return ModuleGroups(config, log)
+
+
+def pytest_collection_modifyitems(items):
+    """Fail the run if a module uses a fixture of :data:`SHARED` without being listed with it."""
     for item in items:
-        shared = [name for name in SHARED_FIXTURES if name in item.fixturenames]
-        group = modules.setdefault(item.module.__name__, item.module.__name__)
-        if shared and group not in SHARED_FIXTURES:
-            modules[item.module.__name__] = shared[0]
-    for item in items:
-        item.add_marker(pytest.mark.xdist_group(modules[item.module.__name__]))
+        for fixture, modules in SHARED.items():
+            if fixture in item.fixturenames and item.module.__name__ not in modules:
+                raise pytest.UsageError(f"{item.module.__name__} uses the session fixture {fixture}: add it to "
+                                        f"tests/conftest.py SHARED[{fixture!r}]")
 
 
 def copy_workflow(destination):
