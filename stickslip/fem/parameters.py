@@ -8,6 +8,8 @@ dimensionless. See docs/fem.md and shared/reference-model.md (section 11).
 import dataclasses
 
 from ..params import ParameterError, param
+from .backends import BACKENDS, DEFAULT_BACKEND
+from .laws import INTERFACE_LAWS
 
 __all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS"]
 
@@ -76,6 +78,12 @@ class FemParams:
                                    "block comes within `margin` wells of the end of its first `nchunk` wells (with "
                                    "'stop' the increment is aborted there; with 'extend' it is completed, not "
                                    "stored)", minimum=0)
+    interface_law: str = param("cusp", "potential of the interface blocks in a well: 'cusp' (parabolas joined by "
+                                       "cusps, the paper's) or 'smooth' (wells joined smoothly; docs/fem.md)",
+                               choices=INTERFACE_LAWS, extension=True)
+    backend: str = param(DEFAULT_BACKEND, "how the numbers are computed: 'structured' (stencil kernels, default) "
+                                          "or 'assembled' (the CSR reference; other round-off, so its own run id)",
+                         choices=tuple(BACKENDS), extension=True)
 
     def check(self):
         """Check conditions across fields."""

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from ..h5io import FileFormatError, open_file, read_table
+from .backends import make_backend
 from .output import RunFile
 from .system import System
 
@@ -23,6 +24,9 @@ class EventReplay:
     ----------
     path : str or os.PathLike
         A ``fem-run`` file.
+    backend : optional
+        How the numbers are computed (:mod:`.backends`); default: the run's own backend
+        (``params.backend``) with one thread, which reproduces the stored increments bit for bit.
 
     Notes
     -----
@@ -30,7 +34,7 @@ class EventReplay:
     stiffness) built, once; each :meth:`failures` costs one kick and one minimisation.
     """
 
-    def __init__(self, path):
+    def __init__(self, path, backend=None):
         self.path = path
         with open_file(path) as file:
             run = RunFile(file)
@@ -38,7 +42,7 @@ class EventReplay:
             table = read_table(file, "increments", rows=run.nstored)
             response = run.linear_response()
             self.N = run.mesh.N
-            self.system = System(run.params, run.mesh)
+            self.system = System(run.params, run.mesh, backend or make_backend(run.params.backend))
         self._kick = table["kick"].to_numpy(dtype=bool)
         self._yield_element = table["yield_element"].to_numpy(dtype=bool)
         self.system.set_linear_response(*response)

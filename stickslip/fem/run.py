@@ -86,8 +86,8 @@ def _header(system, observer, producer):
             "phi": phi, "regime": driving_regime(phi)}
 
 
-def _create(path, params, mesh, threads, producer):
-    system = System(params, mesh, threads=threads)
+def _create(path, params, mesh, backend, producer):
+    system = System(params, mesh, backend)
     system.compute_linear_response()
     observer = Observer(system)
     columns = observable_columns(observer.nlayer, observer.n_interfaces, system.model.free_lever)
@@ -121,7 +121,7 @@ def _stored(output, params):
     return completed
 
 
-def run_simulation(params, output, mesh, threads=1, *, producer):
+def run_simulation(params, output, mesh, backend, *, producer):
     """Run (or resume, or skip if completed) one simulation into ``output``.
 
     While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,
@@ -140,8 +140,9 @@ def run_simulation(params, output, mesh, threads=1, *, producer):
         Simulation file; created if absent, resumed if present and incomplete.
     mesh : stickslip.mesh.LayeredMesh
         Used when the file is created (a resumed file uses its own stored mesh).
-    threads : int, optional
-        Threads of the parallel kernels (1: serial); the file does not depend on it.
+    backend
+        How the numbers are computed (:func:`.backends.make_backend`); must be the backend that
+        ``params.backend`` names (a backend of other round-off must not write under another's run id).
     producer : tuple[str, str]
         Name and version of the solver plugin, recorded in the file.
 
@@ -159,25 +160,27 @@ def run_simulation(params, output, mesh, threads=1, *, producer):
         If the disk is (nearly) full, or ``output`` cannot be written.
     """
     output = Path(output)
+    if backend.name != params.backend:
+        raise ValueError(f"backend {backend.name!r} given for a run whose parameter 'backend' is {params.backend!r}")
     with writer_lock(output):
         completed = _stored(output, params)
         if completed:
             return 0
         if completed is None:
-            _create(output, params, mesh, threads, producer)
+            _create(output, params, mesh, backend, producer)
         else:
             rewrite(output)
-        new, reason = _increments(params, output, threads)
+        new, reason = _increments(params, output, backend)
         rewrite(output, completed=True, stop_reason=reason)
         return new
 
 
-def _increments(params, output, threads):
+def _increments(params, output, backend):
     """Append increments to ``output`` until the run stops; return (number appended, stop reason)."""
     with open_file(output, "r+") as file:
         file.swmr_mode = True
         run = RunFile(file)
-        system = System(params, run.mesh, threads=threads)
+        system = System(params, run.mesh, backend)
         system.set_linear_response(*run.linear_response())
         increment = run.nstored - 1
         system.restore(*run.state(increment))

@@ -9,6 +9,7 @@ parameters is resumed, a completed one is left as it is.
 """
 
 from .. import registry
+from ..fem.backends import make_backend
 from ..fem.parameters import FemParams
 from ..fem.replay import EventReplay
 from ..fem.run import run_simulation
@@ -52,4 +53,5 @@ def stack_mesh(params, inputs):
 @registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads=1, inputs=None):
     """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
-    run_simulation(params, output, stack_mesh(params, inputs), threads=threads, producer=("fem", VERSION))
+    run_simulation(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
+                   producer=("fem", VERSION))
