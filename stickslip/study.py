@@ -263,6 +263,9 @@ def check_sweeps(config):
                 raise ParameterError(f"config {where}: parameter '{both[0]}' is in both params "
                                      f"({params[both[0]]!r}) and grid ({grid[both[0]]!r}); expected it in one of them")
             for key, values in grid.items():
+                if not isinstance(values, list):
+                    raise ParameterError(f"config {where}.grid.{key}: expected a list of values, got {values!r} "
+                                         f"(write [{values!r}], or put it in params)")
                 for j, value in enumerate(values):
                     if value in values[:j]:
                         raise ParameterError(f"config {where}.grid.{key}: value {value!r} is listed twice; "

@@ -1,7 +1,5 @@
 """Verification of the interface laws (stickslip.fem.laws): energy, stress, continuity, barriers, runs."""
 
-import math
-
 import numpy as np
 import pytest
 

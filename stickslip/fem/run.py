@@ -7,7 +7,10 @@ the brink of yielding (odd increments), and a kick followed by minimisation
 redone so that a whole element yields (``yield_element``). The run stops, and
 is marked completed, when a block comes within ``margin`` wells of the end of
 its yield strains (during a minimisation, or after a load step), or after
-``max_increments`` increments. Every increment is appended and committed; a run
+``max_increments`` increments; with unbounded yield strains and ``max_increments``
+0, when an increment leaves a block within ``margin`` wells of the end of its
+first ``nchunk`` wells (where the paper's code stops; that increment is not
+stored). Every increment is appended and committed; a run
 ended in any way (exception, SIGINT, SIGTERM, SIGKILL) resumes from its last
 committed increment and gives the same file, byte for byte, as an uninterrupted
 run. Progress (increments, slip events so far, increments/s, time left when
@@ -16,7 +19,6 @@ Reference: shared/reference-model.md, section 8c.
 """
 
 import json
-import os
 import sys
 from pathlib import Path
 
@@ -24,7 +26,11 @@ import numpy as np
 
 from .. import progress
 from ..formats.fem_run import RunFile, append_increment, create_file, rewrite
-from ..h5io import FileFormatError, UnreadableFileError, atomic_output, check_free_space, open_file, writer_lock
+from ..h5io import FileFormatError, UnreadableFileError, open_file
+from ..output_safety.atomic import atomic_output
+from ..output_safety.lock import writer_lock
+from ..output_safety.overwrite import set_aside
+from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .minimise import within_margin
 from .observables import Observer, observable_columns
@@ -108,23 +114,12 @@ def _stored(output, params):
             stored = stored_params(file)
             completed = bool(file.attrs["completed"])
     except UnreadableFileError as error:
-        aside = _aside(output)
-        os.replace(output, aside)
+        aside = set_aside(output, "unreadable")
         print(f"stickslip: {error}; moved it to {aside}, starting the run over", file=sys.stderr)
         return None
     if params_to_dict(stored) != params_to_dict(params):
         raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
     return completed
-
-
-def _aside(path):
-    """A free name ``<name>.unreadable[-<k>]`` beside ``path``."""
-    aside = path.with_name(f"{path.name}.unreadable")
-    k = 1
-    while aside.exists():
-        k += 1
-        aside = path.with_name(f"{path.name}.unreadable-{k}")
-    return aside
 
 
 def run_simulation(params, output, mesh, backend, *, producer):
@@ -197,6 +192,7 @@ def _increments(params, output, backend):
         reason = ""
         report = _Progress(file, params, increment)
         needed = 2 * run.increment_bytes() + FREE_SPACE_MARGIN
+        last_well = params.nchunk + 1 - params.margin if system.extend and not params.max_increments else None
         while not reason:
             if params.max_increments and increment >= params.max_increments:
                 reason = "max_increments"
@@ -214,7 +210,10 @@ def _increments(params, output, backend):
                 if not system.extend and not within_margin(system.model, system.state.idx, params.margin):
                     reason = "margin"
                     break
-            check_free_space(output, needed)
+            if last_well is not None and system.well_index().max() >= last_well:
+                reason = "margin"
+                break
+            check_free_space(output, needed, FREE_SPACE_MARGIN)
             append_increment(file, system.snapshot(), _row(observer, increment, kick, yield_element, previous_index))
             previous_index = observer.well_index()
             new += 1

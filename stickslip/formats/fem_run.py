@@ -43,9 +43,9 @@ import numbers
 import numpy as np
 
 from .. import __version__, formats
-from ..h5io import (FileFormatError, atomic_output, copy_file, open_file, read_array, read_table, write_attrs,
-                    write_dataset)
+from ..h5io import FileFormatError, copy_file, open_file, read_array, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
+from ..output_safety.atomic import atomic_output
 
 __all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
            "read_increments", "read_run_attrs", "RunFile", "describe"]

@@ -29,7 +29,8 @@ from sqlalchemy.orm import Session
 
 from .. import formats, registry
 from ..formats import event_table
-from ..h5io import FileFormatError, atomic_output
+from ..h5io import FileFormatError
+from ..output_safety.atomic import atomic_output
 from ..progress import iterate
 from .database import ArtifactRow, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
