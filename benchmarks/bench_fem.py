@@ -6,8 +6,8 @@ Usage::
     python benchmarks/bench_fem.py --N 162 --plates 3 --event --events 100 --k_drive 0.081
     python benchmarks/bench_fem.py --N 1458 --plates 6 --linear-response
 
-Per-step mode: time steps right after a kick (blocks yielding), with the assembled plate
-product (the reference) and with the structured kernel; then the cost of each component of a
+Per-step mode: time steps right after a kick (blocks yielding), with the ``assembled`` backend
+(the CSR plate product, the reference) and with the ``structured`` one (the default); then the cost of each component of a
 step (plate product, interface elements incl. the well search, drive, the two Verlet updates,
 and the residual that a minimisation adds per step), as wall time and as CPU time of this
 process (less distorted when the machine is shared); last lines
@@ -17,8 +17,8 @@ along an affine shear instead of the linear response: the cost of a step does no
 
 ``--event``: ``--events`` consecutive events (elastic load step, kick, minimisation with
 the whole-element fallback, i.e. two increments of the protocol) from one seed, once with
-``relaxation = dynamic`` on the assembled plate product (the solver before issue 8) and
-once with ``exact`` on the structured kernel (both start from the same linear response,
+``relaxation = dynamic`` on the ``assembled`` backend (the solver before issue 8) and
+once with ``exact`` on the ``structured`` one (both start from the same linear response,
 solved directly). Prints per relaxation the total and median time steps and
 the wall time per event (mean and median), for all events and by size ``A`` (blocks whose Gauss point 0
 changed well, all interfaces), and last
@@ -36,9 +36,11 @@ import time
 
 import numpy as np
 
+from stickslip.fem.backends import make_backend
 from stickslip.fem.dynamics import _correct, _predict, residual, time_step
-from stickslip.fem.forces import drive_force, interface_forces, plates
 from stickslip.fem.event_driven import autoscale
+from stickslip.fem.forces import drive_force, interface_forces
+from stickslip.fem.plates import plate_force
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.system import System
 from stickslip.mesh import MeshParams, build_stack_mesh
@@ -49,9 +51,9 @@ SMALL = 10
 
 
 @njit
-def _steps(model, state, fe, n):
+def _steps(model, work, state, n):
     for _ in range(n):
-        time_step(model, state, fe)
+        time_step(model, work, state)
 
 
 def _affine_response(system):
@@ -66,10 +68,10 @@ def _affine_response(system):
     system.restore(np.zeros(system.model.ndof), np.zeros(system.mesh.nlayer), 0.0, 0.0)
 
 
-def _loaded_system(args, mesh, threads, plate_kernel):
+def _loaded_system(args, mesh, threads, backend):
     """A system right after a kick (blocks yielding), loaded along an affine shear, and its wells before the kick."""
-    system = System(FemParams(N=args.N, plates=args.plates, nchunk=200), mesh, threads=threads,
-                    plate_kernel=plate_kernel)
+    system = System(FemParams(N=args.N, plates=args.plates, nchunk=200, backend=backend), mesh,
+                    make_backend(backend, threads))
     _affine_response(system)
     system.event_step(kick=False)
     index = system.state.idx.copy()
@@ -77,52 +79,53 @@ def _loaded_system(args, mesh, threads, plate_kernel):
     return system, index
 
 
-def _time_steps(args, mesh, threads, plate_kernel):
-    system, index = _loaded_system(args, mesh, threads, plate_kernel)
-    _steps(system.model, system.state, system._fe, 10)  # warm up (compiles if not cached)
+def _time_steps(args, mesh, threads, backend):
+    system, index = _loaded_system(args, mesh, threads, backend)
+    work = system.backend.work
+    _steps(system.model, work, system.state, 10)  # warm up (compiles if not cached)
     start, cpu = time.perf_counter(), time.process_time()
-    _steps(system.model, system.state, system._fe, args.steps)
+    _steps(system.model, work, system.state, args.steps)
     seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     yielded = int(np.count_nonzero(system.state.idx != index))
     per_step = seconds / args.steps * 1e6
-    print(f"{plate_kernel}: steps={args.steps} seconds={seconds:.3f} gauss_points_yielded={yielded} "
+    print(f"{backend}: steps={args.steps} seconds={seconds:.3f} gauss_points_yielded={yielded} "
           f"time_per_step_us={per_step:.1f} cpu_per_step_us={cpu / args.steps * 1e6:.1f} "
           f"ns_per_element_step={per_step * 1e3 / mesh.nelem:.1f}")
     return per_step, cpu
 
 
 @njit
-def _repeat_plates(model, state, fe, n):
+def _repeat_plates(model, work, state, n):
     for _ in range(n):
-        plates(model, state.u, state.f)
+        plate_force(work.plates, work.nblock, state.u, state.f)
 
 
 @njit
-def _repeat_interfaces(model, state, fe, n):
+def _repeat_interfaces(model, work, state, n):
     for _ in range(n):
-        interface_forces(model, state, fe, True)
+        interface_forces(model, work, state, True)
 
 
 @njit
-def _repeat_drive(model, state, fe, n):
+def _repeat_drive(model, work, state, n):
     for _ in range(n):
         drive_force(model, state)
 
 
 @njit
-def _repeat_predict(model, state, fe, n):
+def _repeat_predict(model, work, state, n):
     for _ in range(n):
         _predict(0, model.ndof, 0.0, state.u, state.v, state.a)  # dt = 0: same work, state unchanged
 
 
 @njit
-def _repeat_correct(model, state, fe, n):
+def _repeat_correct(model, work, state, n):
     for _ in range(n):
         _correct(0, model.ndof, model.dt, model.mass_inv, model.damping, state.f, state.v, state.a)
 
 
 @njit
-def _repeat_residual(model, state, fe, n):
+def _repeat_residual(model, work, state, n):
     total = 0.0
     for _ in range(n):
         total += residual(model, state)
@@ -134,17 +137,17 @@ def _breakdown(args, mesh, threads):
     components = (("plates", _repeat_plates), ("interfaces", _repeat_interfaces), ("drive", _repeat_drive),
                   ("predict", _repeat_predict), ("correct", _repeat_correct), ("residual", _repeat_residual))
     repeat = max(1, args.steps // 4)
-    for plate_kernel in ("assembled", "structured"):
-        system, _ = _loaded_system(args, mesh, threads, plate_kernel)
+    for backend in ("assembled", "structured"):
+        system, _ = _loaded_system(args, mesh, threads, backend)
         parts = []
         for name, kernel in components:
-            if plate_kernel == "structured" or name == "plates":
-                kernel(system.model, system.state, system._fe, 2)  # compile if not cached
+            if backend == "structured" or name == "plates":
+                kernel(system.model, system.backend.work, system.state, 2)  # compile if not cached
                 start, cpu = time.perf_counter(), time.process_time()
-                kernel(system.model, system.state, system._fe, repeat)
+                kernel(system.model, system.backend.work, system.state, repeat)
                 parts.append(f"{name}={(time.perf_counter() - start) / repeat * 1e6:.1f}/"
                              f"{(time.process_time() - cpu) / repeat * 1e6:.1f}")
-        print(f"breakdown {plate_kernel} (us per step, wall/cpu): " + " ".join(parts))
+        print(f"breakdown {backend} (us per step, wall/cpu): " + " ".join(parts))
 
 
 def _per_step(args, mesh, threads):
@@ -189,12 +192,12 @@ def _event_mode(args, mesh, threads):
     _compile_kernels()
     runs = {}
     response = None
-    for relaxation, plate_kernel in (("dynamic", "assembled"), ("exact", "structured")):
+    for relaxation, backend in (("dynamic", "assembled"), ("exact", "structured")):
         params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, nchunk=args.nchunk, seed=args.seed,
-                           relaxation=relaxation)
-        system = System(params, mesh, threads=threads, plate_kernel=plate_kernel)
+                           relaxation=relaxation, backend=backend)
+        system = System(params, mesh, make_backend(backend, threads))
         if response is None:
-            exact = System(params, mesh, threads=threads)
+            exact = System(params, mesh, make_backend(backend, threads))
             start = time.perf_counter()
             exact.compute_linear_response()
             print(f"linear response (direct solve, includes compilation): {time.perf_counter() - start:.2f} s")
@@ -216,15 +219,17 @@ def _event_mode(args, mesh, threads):
 def _compile_kernels():
     """Run a few events of a small system with both relaxations (compiles every kernel not cached)."""
     for relaxation in ("dynamic", "exact"):
-        warm = System(FemParams(N=9, plates=2, nchunk=200, relaxation=relaxation), build_stack_mesh(MeshParams(N=9)))
-        warm.compute_linear_response()
-        _events(warm, 3)
+        for backend in ("assembled", "structured"):
+            warm = System(FemParams(N=9, plates=2, nchunk=200, relaxation=relaxation, backend=backend),
+                          build_stack_mesh(MeshParams(N=9)), make_backend(backend))
+            warm.compute_linear_response()
+            _events(warm, 3)
 
 
 def _linear_response_mode(args, mesh, threads):
     _compile_kernels()
     system = System(FemParams(N=args.N, plates=args.plates, nchunk=args.nchunk, relaxation="exact"), mesh,
-                    threads=threads)
+                    make_backend("structured", threads))
     start = time.perf_counter()
     system.compute_linear_response()
     print(f"linear_response_s={time.perf_counter() - start:.2f}")

@@ -16,7 +16,8 @@ import numpy as np
 from stickslip.experiment.virtual import Apparatus
 from stickslip.experiment.virtual.slab_dynamics import METHODS, SlabDynamics
 from stickslip.params import parse_params
-from stickslip.solvers.rate_state_lever import RateStateLeverParams, law_of
+from stickslip.experiment.virtual.rate_state_model import law_of
+from stickslip.solvers.rate_state_lever import RateStateLeverParams
 
 
 def main(duration):
@@ -31,12 +32,12 @@ def main(duration):
         try:
             dynamics.integrate(y0, 1.0, apparatus.shear_rate, method=method)  # compile
             start = time.perf_counter()
-            t, y, _, _ = dynamics.integrate(y0, duration, apparatus.shear_rate, method=method)
+            t, y, dydt = dynamics.integrate(y0, duration, apparatus.shear_rate, method=method)
             wall = time.perf_counter() - start
         except RuntimeError as error:
             print(f"{method:8s} failed: {error}")
             continue
-        fast = y[:, 1] > params.slip_velocity
+        fast = dydt[:, 0] > params.slip_velocity
         onsets = np.flatnonzero(np.diff(fast.astype(int)) == 1)
         ends = np.flatnonzero(np.diff(fast.astype(int)) == -1)
         T = t[onsets[1]] - t[onsets[0]] if onsets.size > 1 else float("nan")

@@ -22,6 +22,7 @@ import numpy as np
 
 from stickslip.fem.dynamics import residual
 from stickslip.fem.observables import Observer
+from stickslip.fem.backends import make_backend
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.system import System
 from stickslip.mesh import MeshParams, build_stack_mesh
@@ -35,7 +36,7 @@ def main(argv=None):
     parser.add_argument("--increments", type=int, default=40)
     args = parser.parse_args(argv)
     params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, relaxation="exact", seed=1)
-    system = System(params, build_stack_mesh(MeshParams(N=args.N, plates=args.plates)))
+    system = System(params, build_stack_mesh(MeshParams(N=args.N, plates=args.plates)), make_backend())
     system.compute_linear_response()
     observer = Observer(system)
     start = observer.well_index()

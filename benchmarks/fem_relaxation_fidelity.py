@@ -56,14 +56,14 @@ from scipy import sparse, stats
 from scipy.sparse.linalg import eigsh
 
 from stickslip import registry
-from stickslip.events.extraction import classify_increments, slip_events, slip_interfaces
+from stickslip.events.extraction import classify_increments, slip_interfaces, steady_slips
 from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
-from stickslip.fem.dynamics import time_step
+from stickslip.fem.backends import make_backend
 from stickslip.fem.observables import Observer
-from stickslip.fem.output import RunFile, read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.stiffness import stiffness_ratio
 from stickslip.fem.system import System
+from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
@@ -93,12 +93,12 @@ def _increments(system, count):
 def reference(args):
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
     case = {**REFERENCE_CASE, "tol": args.tol}
-    response = System(FemParams(**case), mesh)
+    response = System(FemParams(**case), mesh, make_backend())
     response.compute_linear_response()
     linear = (response.delta_u, response.delta_eps, response.delta_target, response.delta_lever)
     out = {}
     for relaxation in ("dynamic", "exact"):
-        system = System(FemParams(**case, relaxation=relaxation), mesh)
+        system = System(FemParams(**case, relaxation=relaxation), mesh, make_backend())
         system.set_linear_response(*linear)
         start = time.perf_counter()
         out[relaxation] = _increments(system, 1000)
@@ -116,7 +116,7 @@ def reference(args):
     for i in range(max(first - 2, 0), min(first + 2, n)):
         print(f"  increment {i + 1}: (S_a1, A_a1, sigd) dynamic {a[i]['S_a1']}, {a[i]['A_a1']}, {a[i]['sigd']:.9f}; "
               f"exact {b[i]['S_a1']}, {b[i]['A_a1']}, {b[i]['sigd']:.9f}")
-    system = System(FemParams(**case), mesh)
+    system = System(FemParams(**case), mesh, make_backend())
     system.set_linear_response(*linear)
     system.event_step(False)
     system.kick(system.params.margin)
@@ -155,7 +155,7 @@ def _slip_sample(label, params, args):
     classified = classify_increments(table, N)
     if args.start is not None:  # instead of the extraction's steady state (needs every interface to slip once)
         classified["steady"] = classified["increment"].to_numpy() >= args.start
-    slips = slip_events(classified, N)
+    slips = steady_slips(classified, N)
     counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
     drops = slip_interfaces(classified, N)["dmu"].to_numpy()
     events = classified["kick"].to_numpy() & classified["steady"].to_numpy(dtype=bool)
@@ -205,7 +205,7 @@ def time_step_study(args):
 
 def _kick_outcomes(params, mesh, response, states):
     """Kick and minimise every stored state with ``params``; per state (S, global well indices, sigd)."""
-    system = System(FemParams(**params), mesh)
+    system = System(FemParams(**params), mesh, make_backend())
     system.set_linear_response(*response)
     observer = Observer(system)
     out = []
@@ -264,7 +264,7 @@ def stability(args):
     """The explicit stability limit of the time step: computed, then tried after a kick."""
     mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
     params = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "relaxation": "exact"}
-    system = System(FemParams(**params), mesh)
+    system = System(FemParams(**params), mesh, make_backend())
     stiffness = system.equilibrium.matrix  # plates + interfaces with the elastic (stiffest) law, free DOFs
     weight = sparse.diags(np.sqrt(system.model.mass_inv[system.equilibrium.free]))
     omega = float(np.sqrt(eigsh(weight @ stiffness @ weight, k=1, which="LA", return_eigenvectors=False)[0]))
@@ -278,12 +278,12 @@ def stability(args):
     kicked = system.snapshot()
     bound = np.inf  # 1e3 times the largest kinetic energy with the first dt_scale
     for scale in (*args.scales, 0.95 * limit, 1.05 * limit):
-        trial = System(FemParams(**params, dt_scale=scale), mesh)
+        trial = System(FemParams(**params, dt_scale=scale), mesh, make_backend())
         trial.set_linear_response(*response)
         trial.restore(*kicked)
         energy = np.empty(args.steps)
         for i in range(args.steps):
-            time_step(trial.model, trial.state, trial._fe)
+            trial.backend.time_step(trial.model, trial.state)
             energy[i] = _kinetic_energy(trial.model, trial.state)
             if not energy[i] < bound:
                 break

@@ -40,10 +40,12 @@ from scipy import stats
 
 from stickslip.events import fronts
 from stickslip.events.extraction import classify_increments
-from stickslip.fem.output import RunFile, read_increments, read_run_attrs
+from stickslip.fem.backends import make_backend
+from stickslip.fem.parameters import stored_params
 from stickslip.fem.system import System
+from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
-from stickslip.mesh import interface_layer, load_mesh
+from stickslip.mesh import interface_layer
 
 
 def replays(path, scales, max_events):
@@ -55,11 +57,11 @@ def replays(path, scales, max_events):
     chosen = fronts.multi_slip_increments(classified, max_events)
     with open_file(path) as file:
         run = RunFile(file)
-        params, mesh, response = run.params, run.mesh, run.linear_response()
+        params, mesh, response = stored_params(file), run.mesh, run.linear_response()
         states = {int(i): (run.state(int(i) - 1), run.state(int(i))) for i in chosen}
     yield_element = table["yield_element"].to_numpy(dtype=bool)
     for scale in scales:
-        system = System(dataclasses.replace(params, dt_scale=float(scale)), mesh)
+        system = System(dataclasses.replace(params, dt_scale=float(scale)), mesh, make_backend(params.backend))
         system.set_linear_response(*response)
         for increment, (before, after) in states.items():
             system.restore(*before)
@@ -124,7 +126,7 @@ def main(argv=None):
         own = float(params["dt_scale"])
         scales = [own] + [s for s in (args.scales or []) if s != own]
         with open_file(path) as file:
-            heights = load_mesh(file["mesh"]).layer_mid_height
+            heights = RunFile(file).mesh.layer_mid_height
         spacing = fronts.interface_spacing([heights[interface_layer(a)] for a in (1, 2)])
         c_d = fronts.p_wave_speed(params["K"], params["G"], params["rho"])
         plate = float(heights[2] - heights[0]) / h  # plate plus interface, in blocks

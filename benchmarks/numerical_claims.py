@@ -33,9 +33,9 @@ from stickslip.fem.stiffness import at_paper_phi
 from stickslip.figures.numerical_common import run_phi
 
 
-def read(trees, analysis, tables):
-    """Analysis files of the runs at the paper's Phi under the results trees."""
-    files = [read_analysis_file(path, tables) for tree in trees
+def read(trees, analysis, fmt, tables):
+    """Analysis files (of format ``fmt``) of the runs at the paper's Phi under the results trees."""
+    files = [read_analysis_file(path, fmt, tables) for tree in trees
              for path in sorted(Path(tree).glob(f"events/{analysis}/*/*.h5"))]
     return [item for item in files if at_paper_phi(run_phi(item.attrs))]
 
@@ -48,7 +48,7 @@ def pm(value, error, digits=2):
 
 
 def main(trees):
-    events = read(trees, "numerical-events", ("slips", "slip_interfaces", "sequences", "periodicity"))
+    events = read(trees, "numerical-events", "event-table", ("slips", "slip_interfaces", "sequences", "periodicity"))
     if not events:
         raise SystemExit(f"no numerical-events file at the paper's Phi under {', '.join(trees)}")
     groups = {}
@@ -83,7 +83,7 @@ def main(trees):
               f"count={int(row['count'])} "
               f"mean={row['mean']:.4f} +- {row['run_mean_error']:.4f} (runs) shift={100 * row['shift']:+.1f} % "
               f"p={row['p_value']:.2g} detectable={100 * row['detectable_shift']:.1f} % p_runs={row['p_runs']:.2g}")
-    fronts = read(trees, "front-dynamics", ("fronts",))
+    fronts = read(trees, "front-dynamics", "front-table", ("fronts",))
     if fronts:
         print("\nfront speed c_f [c_s] of the re-run multi-slips (meaningful fits only) and tau [H/c_s]:")
         table = front_speed_by_size(fronts)

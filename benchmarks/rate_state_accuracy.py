@@ -25,7 +25,8 @@ import time
 import numpy as np
 
 from stickslip.params import parse_params
-from stickslip.solvers.rate_state_lever import RateStateLeverParams, simulate
+from stickslip.experiment.virtual.rate_state_model import simulate
+from stickslip.solvers.rate_state_lever import RateStateLeverParams
 
 RUNS = (("RODAS4", 1e-3), ("RODAS4", 3e-4), ("RODAS4", 1e-4), ("RODAS4", 1e-5), ("RODAS4", 1e-9))
 REFERENCE = ("RODAS4", 1e-8)

@@ -15,8 +15,9 @@ deviation, sqrt(N) for a count; over seeds for R_slow):
 - the aging fit (origin and free intercept) on all stack slips, and per n;
 - mean and standard deviation of B_a per interface and n, the latter normalised by n = 1; and the
   standard deviation within one seed (the paper's situation: one apparatus), median over the seeds,
-  normalised by the individual protocol's (seed 1);
-- R_slow per interface and n;
+  normalised by the same of the individual protocol;
+- R_slow per interface and n, and with the slabs shuffled (the runs with a ``slab_order`` are left out
+  of everything else);
 - slips in multi-slip events.
 Slips in the first ``t_exclude`` = 300 s are already left out by the analysis.
 """
@@ -34,10 +35,14 @@ from stickslip.figures.experimental_data import load_interfaces
 
 
 def load(study):
-    """Slips of the study's database: columns a, n, protocol, seed, run, dmu, T, B_a, multi."""
+    """Slips of the study's database, the runs with the slabs shuffled left out: columns a, n,
+    protocol, seed, run, dmu, T, B_a, multi."""
     with sqlite3.connect(Path(study) / "stickslip.sqlite") as db:
-        rows = pd.read_sql("SELECT simulation_run_id AS run, interface AS a, dmu, multi, extra, protocol, n, seed "
-                           "FROM slip_events_full WHERE analysis = 'experiment-events'", db)
+        rows = pd.read_sql("SELECT e.simulation_run_id AS run, e.interface AS a, e.dmu, e.multi, e.extra, e.protocol, "
+                           "e.n, e.seed, r.params FROM slip_events_full AS e JOIN runs AS r "
+                           "ON r.run_id = e.simulation_run_id WHERE e.analysis = 'experiment-events'", db)
+    shuffled = np.array([bool(json.loads(text).get("slab_order")) for text in rows.pop("params")], dtype=bool)
+    rows = rows[~shuffled].reset_index(drop=True)
     extra = pd.DataFrame([json.loads(text) for text in rows.pop("extra")], index=rows.index)
     slips = rows.assign(T=extra["T"].astype(float))
     slips["B_a"] = aging_rate(slips["dmu"], slips["T"])
@@ -101,18 +106,19 @@ def main(study):
     for a, part in table.groupby("a"):
         cells = [f"n={n}: {g['B_a'].mean():.4f}+-{sem(g['B_a']):.4f}" for n, g in part.groupby("n")]
         print(f"  a={a}: " + "  ".join(cells))
-    print("\nstd(B_a) +- err per a and n, and normalised by its n = 1 value (spread_of_aging_rate)")
+    print("\nstd(B_a) +- err per a and n, and normalised by its n = 1 value +- jackknife error over the seeds "
+          "(spread_of_aging_rate)")
     spread = spread_of_aging_rate(slips)
     for a, part in table.groupby("a"):
         errors = {n: std_error(g["B_a"]) for n, g in part.groupby("n")}
         rows = spread[spread["a"] == a]
-        cells = [f"n={r.n}: {r.std:.4f}+-{errors.get(r.n, np.nan):.4f} ({r.std_normalised:.1f}x, N={r.count})"
-                 for r in rows.itertuples()]
+        cells = [f"n={r.n}: {r.std:.4f}+-{errors.get(r.n, np.nan):.4f} ({r.std_normalised:.2f}"
+                 f"+-{r.std_normalised_error:.2f}x, N={r.count})" for r in rows.itertuples()]
         print(f"  a={a}: " + "  ".join(cells))
 
-    print("\nstd(B_a) within one seed: median over the seeds per a and n (stack), normalised by the individual"
-          " protocol's (n = 1)")
-    individual = table[table["protocol"] == "individual"].groupby("a")["B_a"].std()
+    print("\nstd(B_a) within one seed (one apparatus: the seeds' quenched disorder left out): median over the seeds "
+          "per a and n, normalised by that of the individual protocol (n = 1, also within one seed)")
+    individual = table[table["protocol"] == "individual"].groupby(["a", "seed"])["B_a"].std().groupby("a").median()
     for a, part in table[table["protocol"] == "stack"].groupby("a"):
         cells = [f"n={n}: {g.groupby('seed')['B_a'].std().median():.4f}"
                  f" ({g.groupby('seed')['B_a'].std().median() / individual.get(a, np.nan):.1f}x)"
@@ -120,11 +126,17 @@ def main(study):
         print(f"  a={a}: n=1: {individual.get(a, np.nan):.4f}  " + "  ".join(cells))
 
     paths = sorted((Path(study) / "events" / "experiment-events").glob("*/*.h5"))
-    interfaces = load_interfaces(paths)
+    interfaces = load_interfaces(paths, shuffled=True)
     driven = interfaces[(interfaces["protocol"] == "stack") & (interfaces["a"] <= interfaces["n"])]
-    print("\nR_slow = 1 - sum(dR)/R_tot, stack, mean +- sem over seeds, per a (rows) and n (columns)")
+    print("\nR_slow = 1 - sum(dR)/R_tot, stack, mean +- sem over seeds, per a (rows) and n (columns); 'shuffled':"
+          " n = 5 with the slabs shuffled (a is the position)")
     for a, part in driven.groupby("a"):
-        cells = [f"n={n}: {g['R_slow'].mean():.3f}+-{sem(g['R_slow']):.3f}" for n, g in part.groupby("n")]
+        cells = [f"n={n}: {g['R_slow'].mean():.3f}+-{sem(g['R_slow']):.3f}" for n, g in
+                 part[~part["shuffled"]].groupby("n")]
+        moved = part[part["shuffled"]]
+        if len(moved):
+            cells.append(f"shuffled ({moved['slab_order'].iloc[0]}): {moved['R_slow'].mean():.3f}+-"
+                         f"{sem(moved['R_slow']):.3f}")
         print(f"  a={a}: " + "  ".join(cells))
 
     multi = int(slips["multi"].astype(bool).sum())

@@ -18,7 +18,8 @@ import time
 from stickslip.experiment.virtual.model import simulate as lever_simulate
 from stickslip.params import parse_params
 from stickslip.solvers.lever import LeverParams
-from stickslip.solvers.rate_state_lever import RateStateLeverParams, simulate as rate_state_simulate
+from stickslip.experiment.virtual.rate_state_model import simulate as rate_state_simulate
+from stickslip.solvers.rate_state_lever import RateStateLeverParams
 
 RUNS = [{"protocol": "stack", "n": n} for n in range(1, 6)] + \
        [{"protocol": "individual", "n": 1, "a": a} for a in range(1, 6)]

@@ -17,8 +17,16 @@ Notes
 ``fastmath`` stays off: reordering floating-point operations would break the
 bit-identical reproducibility promised for the same parameters and seed.
 
-numba's on-disk cache has two defects that hit Snakemake jobs sharing one cache
-directory; both are worked around here, on import:
+numba's on-disk cache has three defects, worked around here on import:
+
+- Stale callees: numba keys a cached kernel by its own source file only, so a kernel
+  that calls (and inlines) code of another module, e.g. an interface law
+  (:mod:`stickslip.fem.laws`) or a backend's plate operator, would keep running the old
+  code after that module changed. :func:`key_cache_on_subpackage` keys every kernel of
+  the package on all the sources of its subpackage (``stickslip/fem/**`` for the fem
+  kernels) and on this module.
+
+and two that hit Snakemake jobs sharing one cache directory:
 
 - Concurrent writers: each process reads a function's index, picks the first free
   data-file number and writes both, so two processes compiling different
@@ -36,7 +44,10 @@ directory; both are worked around here, on import:
 """
 
 import fcntl
+import functools
+import hashlib
 import os
+from pathlib import Path
 
 import numba
 from numba.core import caching
@@ -91,6 +102,71 @@ def start_threading_layer():
     return numba.get_num_threads()  # launches the threading layer on the first call
 
 
+#: The package's directory: kernels defined below it are keyed on their subpackage's sources.
+PACKAGE_DIR = Path(__file__).resolve().parent
+
+
+@functools.lru_cache(maxsize=None)
+def _sources_digest(directory, stamps):
+    digest = hashlib.sha256()
+    for path, _ in stamps:
+        digest.update(os.path.relpath(path, directory).encode())
+        digest.update(Path(path).read_bytes())
+    return digest.hexdigest()
+
+
+def subpackage_digest(path, package_dir=PACKAGE_DIR):
+    """sha256 of the sources a kernel defined in ``path`` may depend on (hex).
+
+    The sources are every ``*.py`` below the top-level subpackage of the package that holds
+    ``path`` (``stickslip/fem/`` for ``stickslip/fem/laws/cusp.py``; the file's own directory
+    if it lies directly in the package) and this module. Memoised on the files' modification
+    times and sizes, so an edit while the process runs is seen.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A source file below ``package_dir``.
+    package_dir : pathlib.Path, optional
+        The package's directory (default :data:`PACKAGE_DIR`).
+
+    Returns
+    -------
+    str
+    """
+    package_dir = Path(package_dir).resolve()
+    relative = Path(path).resolve().relative_to(package_dir)
+    directory = package_dir / relative.parts[0] if len(relative.parts) > 1 else package_dir
+    files = sorted(set(directory.rglob("*.py")) | {Path(__file__).resolve()})
+    stamps = tuple((str(f), (f.stat().st_mtime_ns, f.stat().st_size)) for f in files)
+    return _sources_digest(str(directory), stamps)
+
+
+def key_cache_on_subpackage():
+    """Key the cached kernels of the package on their subpackage's sources (:func:`subpackage_digest`).
+
+    Wraps ``get_source_stamp`` of numba's file-backed cache locators (numba pinned in
+    environment.txt): for a kernel defined below :data:`PACKAGE_DIR` the stamp becomes the
+    pair (numba's own stamp of its file, the subpackage's digest), so any change of a module it
+    may inline recompiles it. Kernels of other packages keep numba's stamp. Idempotent.
+    """
+    mixin = caching._SourceFileBackedLocatorMixin
+    stamp = mixin.get_source_stamp
+    if getattr(stamp, "keyed_on_subpackage", False):
+        return
+
+    def keyed_stamp(self):
+        own = stamp(self)
+        path = Path(self._py_file).resolve()
+        if PACKAGE_DIR not in path.parents:
+            return own
+        return own, subpackage_digest(path)
+
+    keyed_stamp.keyed_on_subpackage = True
+    mixin.get_source_stamp = keyed_stamp
+
+
+key_cache_on_subpackage()
 serialise_cache_writes()
 start_threading_layer()
 

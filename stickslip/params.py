@@ -14,9 +14,15 @@ Supported field types: ``int``, ``float``, ``bool``, ``str`` and tuples
 ``tuple[int, ...]``, ``tuple[float, ...]`` (written ``1,2,3`` on a command line).
 A dataclass may define ``check(self)``, called after the per-field checks, for
 conditions that involve several fields; it raises :class:`ParameterError`.
+
+A field added to a plugin after runs were made is declared with ``extension=True``:
+while it has its default it is left out of :func:`params_to_dict`, so the run ids,
+stored parameters and files of the runs made before it keep their bytes (its default
+must reproduce what those runs did); any other value is stored and keyed as usual.
 """
 
 import dataclasses
+import difflib
 import math
 import typing
 from collections.abc import Iterable
@@ -25,6 +31,7 @@ __all__ = [
     "ParameterError",
     "param",
     "parse_params",
+    "did_you_mean",
     "parse_assignments",
     "params_to_dict",
     "json_schema",
@@ -36,7 +43,8 @@ class ParameterError(ValueError):
     """A parameter name or value is not acceptable; the message says which and why."""
 
 
-def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, exclusive_minimum=None):
+def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, exclusive_minimum=None,
+          extension=False):
     """Declare one plugin parameter.
 
     Parameters
@@ -53,13 +61,17 @@ def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, ex
         Inclusive bounds (for tuples: of every element).
     exclusive_minimum : float, optional
         Exclusive lower bound (for tuples: of every element).
+    extension : bool, optional
+        The field was added after runs were made: at its default it is left out of
+        :func:`params_to_dict` (run ids, stored parameters), so those runs keep their ids.
 
     Returns
     -------
     dataclasses.Field
     """
     meta = {"doc": doc, "unit": unit, "choices": tuple(choices) if choices is not None else None,
-            "minimum": minimum, "maximum": maximum, "exclusive_minimum": exclusive_minimum}
+            "minimum": minimum, "maximum": maximum, "exclusive_minimum": exclusive_minimum,
+            "extension": bool(extension)}
     return dataclasses.field(default=default, metadata=meta)
 
 
@@ -174,8 +186,8 @@ def parse_params(cls, values=None, *, owner=""):
     if unknown:
         where = f" of {owner}" if owner else ""
         raise ParameterError(
-            f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}{where}; "
-            f"allowed: {', '.join(types)}")
+            f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}{where}"
+            f"{did_you_mean(unknown[0], types)}; allowed: {', '.join(types)}")
     kwargs = {}
     for f in dataclasses.fields(cls):
         if f.name in values:
@@ -215,10 +227,30 @@ def parse_assignments(assignments):
     return values
 
 
+def did_you_mean(name, choices):
+    """`` (did you mean 'x'?)`` for the choice closest to a misspelt ``name``; empty if none is close.
+
+    Parameters
+    ----------
+    name : str
+    choices : Iterable[str]
+
+    Returns
+    -------
+    str
+    """
+    close = difflib.get_close_matches(name, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 def params_to_dict(instance):
-    """Return the parameters as a JSON-safe dict (tuples become lists), in field order."""
+    """Return the parameters as a JSON-safe dict (tuples become lists), in field order.
+
+    Fields declared with ``extension=True`` are left out while they have their default.
+    """
     return {f.name: list(v) if isinstance(v := getattr(instance, f.name), tuple) else v
-            for f in dataclasses.fields(instance)}
+            for f in dataclasses.fields(instance)
+            if not (f.metadata.get("extension") and getattr(instance, f.name) == f.default)}
 
 
 _JSON_TYPES = {int: "integer", float: "number", bool: "boolean", str: "string"}

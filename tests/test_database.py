@@ -153,7 +153,7 @@ def test_the_periodicity_of_a_numerical_run_goes_to_its_table_and_view(tmp_path,
     """An event file's one-row ``periodicity`` table -> ``run_periodicity``; the view adds the simulation's columns."""
     from stickslip.events.plugin import NAME, VERSION, event_attrs, event_tables, write_event_file
     from stickslip.provenance.record import recording
-    from test_events_extraction import EVENTS, N, history
+    from test_events_extraction import EVENTS, N, history, run_attrs
 
     monkeypatch.chdir(tmp_path)
     simulation = Artifact("sim/abc.h5", "0123456789abcdef", "fem", "fem-run")
@@ -163,7 +163,7 @@ def test_the_periodicity_of_a_numerical_run_goes_to_its_table_and_view(tmp_path,
     with recording("events/abc.provenance.json", [("output", "events/abc.h5", "event-table")], run_id="fedcba9876543210",
                    kind="analysis", plugin=NAME, plugin_version=VERSION, code_hash="x", params={},
                    inputs=[("simulation", simulation)]):
-        write_event_file(tables, event_attrs({"N": N, "plates": 3, "k_drive": 1e-3}, tables["increments"]),
+        write_event_file(tables, event_attrs(run_attrs(N, 3, 1e-3), tables["increments"]),
                          "events/abc.h5", input=simulation.path)
     ingest("db.sqlite", ["events/abc.provenance.json"])
     row = query.sql("SELECT * FROM periodicity_full", "db.sqlite")

@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from stickslip.fem.dynamics import time_step
+from stickslip.fem.backends import make_backend
 from stickslip.fem.event_driven import step_size
 from stickslip.fem.materials import equivalent_strain
 from stickslip.fem.model import build_model, new_state
@@ -14,7 +14,7 @@ from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.random import pcg32_uint32, pcg32_uniform
 from stickslip.fem.system import System
-from stickslip.fem.forces import compute_force, compute_force_in_wells
+from stickslip.fem.laws import LAWS, Cusp
 from stickslip.fem.yield_strains import interface_initstate, yield_strains
 from stickslip.mesh import MeshParams, build_stack_mesh
 
@@ -47,7 +47,7 @@ def test_yield_strains_statistics_and_seeding():
 def stack():
     """A 3-plate stack with coarsening rows (N = 18)."""
     mesh = build_stack_mesh(MeshParams(N=18, plates=3))
-    return System(FemParams(N=18, plates=3, nchunk=50), mesh)
+    return System(FemParams(N=18, plates=3, nchunk=50), mesh, make_backend())
 
 
 def test_homogeneous_simple_shear_gives_the_shear_modulus(stack):
@@ -92,12 +92,12 @@ def _undamped_energy_error(system, dt, nsteps):
     x, y = system.mesh.coor[:, 0], system.mesh.coor[:, 1]
     L, H = system.mesh.N * system.mesh.h, y.max()
     state.u[system.mesh.dofs[:, 0]] = 1e-6 * np.sin(2 * np.pi * x / L) * np.sin(np.pi * y / H)
-    fe = np.zeros((model.iface_dofs.shape[0], 8))
-    compute_force(model, state, fe)
+    backend = system.backend
+    backend.force(model, state)
     mass = np.where(model.mass_inv > 0, 1.0 / np.where(model.mass_inv > 0, model.mass_inv, 1.0), 0.0)
     energies = []
     for _ in range(nsteps):
-        time_step(model, state, fe)
+        backend.time_step(model, state)
         energies.append(0.5 * mass @ state.v**2 + 0.5 * state.u @ state.f)
     energies = np.array(energies)
     return np.abs(energies - energies[0]).max() / energies[0]
@@ -131,8 +131,9 @@ def _column_mesh(nx, ny, h):
 def test_shear_pulse_travels_at_the_shear_wave_speed():
     h, nx, ny = np.pi, 4, 400
     mesh = _column_mesh(nx, ny, h)
-    model = build_model(mesh, epsy=np.zeros((0, 3)), K=4.5, G=1.0, rho=1.0, alpha=0.0, dt=0.05, k_drive=0.0,
+    model = build_model(mesh, epsy=np.zeros((0, 3)), law=Cusp(4.5, 1.0), rho=1.0, alpha=0.0, dt=0.05, k_drive=0.0,
                         drive_active=np.array([False]), free_lever=False, lever_height=1.0)
+    backend = make_backend().prepare(model, mesh)
     c_s = math.sqrt(1.0 / 2.0 / 1.0)
     state = new_state(model)
     y = mesh.coor[:, 1]
@@ -141,8 +142,7 @@ def test_shear_pulse_travels_at_the_shear_wave_speed():
     state.u[mesh.dofs[:, 0]] = 1e-6 * profile
     state.v[mesh.dofs[:, 0]] = 1e-6 * 2 * (y - y0) / width**2 * profile * c_s  # u(y - c_s t)
     state.v[model.prescribed] = 0.0
-    fe = np.zeros((0, 8))
-    compute_force(model, state, fe)
+    backend.force(model, state)
     column = mesh.dofs[mesh.coor[:, 0] == 0, 0]
     ycol = y[mesh.coor[:, 0] == 0]
 
@@ -153,7 +153,7 @@ def test_shear_pulse_travels_at_the_shear_wave_speed():
     start = centre()
     nsteps = 4000
     for _ in range(nsteps):
-        time_step(model, state, fe)
+        backend.time_step(model, state)
     speed = (centre() - start) / (nsteps * model.dt)
     assert speed == pytest.approx(c_s, rel=0.01)
 
@@ -187,22 +187,26 @@ def test_linear_response_and_load_step_superpose(stack):
     assert kick * equivalent_strain(*s.delta_eps.reshape(-1, 3).max(axis=0)) < 10 * s.constants["deps"]
 
 
+@pytest.mark.parametrize("law", sorted(LAWS))
 @pytest.mark.parametrize("update_wells", [True, False])
-def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells):
-    # every interface Gauss point: strain (element_strain), well (well_index) and cusp stress
-    # (cusp_stress) evaluated one by one must give the same bits as the vectorised kernel, with
-    # displacements large enough that many points change well (the recompute path)
-    from stickslip.fem.materials import cusp_stress, well_index
+def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells, law):
+    # every interface Gauss point: strain (element_strain), well (well_index) and the law's stress
+    # (well_stress, its scalar reference) evaluated one by one must give the same bits as the
+    # vectorised kernel, with displacements large enough that many points change well (the
+    # recompute path)
+    from stickslip.fem.laws import well_index, well_stress
     from stickslip.fem.quad4 import element_strain
 
-    system = System(FemParams(N=9, plates=3, nchunk=50), build_stack_mesh(MeshParams(N=9, plates=3)))
+    system = System(FemParams(N=9, plates=3, nchunk=50, interface_law=law), build_stack_mesh(MeshParams(N=9, plates=3)),
+                    make_backend())
     model, state = system.model, new_state(system.model)
+    assert model.law.name == law
     rng = np.random.default_rng(3)
     state.u[:] = 2e-3 * rng.standard_normal(model.ndof)
     state.idx[:] = rng.integers(0, 5, state.idx.shape)
     before = state.idx.copy()
-    fe = np.zeros((model.iface_dofs.shape[0], 8))
-    compute_force(model, state, fe) if update_wells else compute_force_in_wells(model, state, fe)
+    system.backend.force(model, state, update_wells)
+    fe = system.backend.work.iface.fe
     moved = 0
     for e in range(model.iface_dofs.shape[0]):
         eps = np.zeros((4, 3))
@@ -214,7 +218,7 @@ def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells
                 i = well_index(model.epsy[e], equivalent_strain(*eps[q]), i)
             moved += i != before[e, q]
             assert state.idx[e, q] == i
-            sig = cusp_stress(*eps[q], model.K, model.G, 0.5 * (model.epsy[e, i] + model.epsy[e, i + 1]))
+            sig = well_stress(model.law, *eps[q], model.epsy[e, i], model.epsy[e, i + 1])
             assert state.eps[e, q].tobytes() == eps[q].tobytes()
             assert state.sig[e, q].tobytes() == np.array(sig).tobytes()
             for m in range(4):

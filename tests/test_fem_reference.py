@@ -11,8 +11,8 @@ import pytest
 from conftest import FEM_REFERENCE_CASE as REFERENCE_CASE
 from stickslip import registry
 from stickslip.cli import main
-from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.fem.replay import EventReplay
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
 
@@ -99,12 +99,15 @@ def test_one_replay_serves_every_event_of_a_run(fem_reference_run):
 
 def _indices(path, increment):
     """Well index of Gauss point 0 of every block at ``increment - 1`` and ``increment``."""
-    from stickslip.fem.output import RunFile
+    from stickslip.fem.backends import make_backend
+    from stickslip.fem.parameters import stored_params
     from stickslip.fem.system import System
+    from stickslip.formats.fem_run import RunFile
 
     with h5py.File(path) as file:
         run = RunFile(file)
-        system = System(run.params, run.mesh)
+        params = stored_params(file)
+        system = System(params, run.mesh, make_backend(params.backend))
         out = []
         for inc in (increment - 1, increment):
             system.restore(*run.state(inc))
@@ -133,7 +136,7 @@ def test_cli_rejects_bad_parameters_naming_them(tmp_path, capsys):
 def test_results_do_not_depend_on_the_number_of_threads():
     import numba
 
-    from stickslip.fem.dynamics import time_step
+    from stickslip.fem.backends import make_backend
     from stickslip.fem.system import System
     from stickslip.mesh import MeshParams, build_stack_mesh
     from stickslip.numba_options import set_num_threads
@@ -146,12 +149,12 @@ def test_results_do_not_depend_on_the_number_of_threads():
     states = []
     for threads in (1, 2):
         set_num_threads(threads)
-        system = System(params, mesh, threads=threads)
+        system = System(params, mesh, make_backend(params.backend, threads))
         system.compute_linear_response()
         system.event_step(kick=False)
         system.event_step(kick=True)
         for _ in range(300):  # blocks yield during these steps
-            time_step(system.model, system.state, system._fe)
+            system.backend.time_step(system.model, system.state)
         states.append(system.state)
     set_num_threads(1)
     for name in ("u", "v", "a", "f", "idx", "sig"):

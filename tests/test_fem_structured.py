@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from stickslip.fem.assembly import assemble_csr, elastic_element_stiffness, element_dofs
-from stickslip.fem.forces import compute_force, plates
+from stickslip.fem.backends import make_backend
 from stickslip.fem.model import new_state
+from stickslip.fem.plates import plate_force
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.quad4 import element_coordinates, shape_gradients
 from stickslip.fem.structured import balanced_blocks, build_stencils, plan_product, plate_product
@@ -18,18 +19,18 @@ from stickslip.mesh import MeshParams, build_stack_mesh
 def test_stencils_equal_the_assembled_product_on_random_displacements(N, plates_):
     # n = plates - 1 = 1..5 interfaces; random displacements reach every row, the periodic wrap included
     mesh = build_stack_mesh(MeshParams(N=N, plates=plates_))
-    systems = [System(FemParams(N=N, plates=plates_, nchunk=20), mesh, plate_kernel=kernel)
-               for kernel in ("structured", "assembled")]
+    systems = [System(FemParams(N=N, plates=plates_, nchunk=20), mesh, make_backend(name))
+               for name in ("structured", "assembled")]
     rng = np.random.default_rng(N * 10 + plates_)
     u = rng.standard_normal(systems[0].model.ndof)
     forces = []
     for system in systems:
         state = new_state(system.model)
         state.u[:] = u
-        compute_force(system.model, state, system._fe)
+        system.backend.force(system.model, state)
         forces.append(state.f)
     np.testing.assert_allclose(forces[0], forces[1], rtol=0, atol=1e-12 * np.abs(forces[1]).max())
-    model = systems[0].model
+    model, work = systems[0].model, systems[0].backend.work
     # the plates alone, and a displacement that differs between the first and the last node of every
     # line (the wrap couples them): equal row by row to the CSR product
     ramp = np.full(model.ndof // 2, np.inf)  # x of each node (periodic images share the first node's DOFs)
@@ -38,11 +39,11 @@ def test_stencils_equal_the_assembled_product_on_random_displacements(N, plates_
         expected = np.array([model.k_val[model.k_ptr[i]:model.k_ptr[i + 1]] @ displacement[model.k_col[
             model.k_ptr[i]:model.k_ptr[i + 1]]] for i in range(model.ndof)])
         f = np.full(model.ndof, np.nan)  # every entry must be written
-        plates(model, displacement, f)
+        plate_force(work.plates, work.nblock, displacement, f)
         np.testing.assert_allclose(f, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
     # a rigid translation in x is force free (the periodic wrap included)
     plates_only = np.full(model.ndof, np.nan)
-    plates(model, np.tile([1.0, 0.0], model.ndof // 2), plates_only)
+    plate_force(work.plates, work.nblock, np.tile([1.0, 0.0], model.ndof // 2), plates_only)
     assert np.abs(plates_only).max() < 1e-12
 
 
@@ -68,14 +69,15 @@ def test_stencils_of_a_single_row_pair_are_the_element_stiffness():
 @pytest.mark.parametrize("threads", [2, 3])
 def test_parallel_product_has_the_serial_bits(threads):
     mesh = build_stack_mesh(MeshParams(N=54, plates=3))
-    serial = System(FemParams(N=54, plates=3, nchunk=20), mesh).model
-    parallel = System(FemParams(N=54, plates=3, nchunk=20), mesh, threads=threads).model
-    assert parallel.nblock > 1
-    u = np.random.default_rng(1).standard_normal(serial.ndof)
-    f_serial, f_parallel = np.zeros(serial.ndof), np.zeros(serial.ndof)
-    plates(serial, u, f_serial)
-    plates(parallel, u, f_parallel)
-    assert f_serial.tobytes() == f_parallel.tobytes()
+    for name in ("structured", "assembled"):
+        serial = System(FemParams(N=54, plates=3, nchunk=20), mesh, make_backend(name)).backend.work
+        parallel = System(FemParams(N=54, plates=3, nchunk=20), mesh, make_backend(name, threads)).backend.work
+        assert parallel.nblock > 1
+        u = np.random.default_rng(1).standard_normal(mesh.dofs.max() + 1)
+        f_serial, f_parallel = np.zeros(u.size), np.zeros(u.size)
+        plate_force(serial.plates, serial.nblock, u, f_serial)
+        plate_force(parallel.plates, parallel.nblock, u, f_parallel)
+        assert f_serial.tobytes() == f_parallel.tobytes()
 
 
 def test_balanced_blocks_split_the_work_evenly():

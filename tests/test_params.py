@@ -29,7 +29,8 @@ def test_defaults_and_conversion_from_strings():
 
 
 @pytest.mark.parametrize("values, words", [
-    ({"Nx": 3}, ["'Nx'", "allowed: N, k_drive, drive, creep, B"]),
+    ({"Nx": 3}, ["'Nx'", "allowed: N, k_drive, drive, creep, B", "(did you mean 'N'?)"]),
+    ({"k_drvie": 1.0}, ["unknown parameter 'k_drvie' (did you mean 'k_drive'?); allowed: N, k_drive"]),
     ({"N": "nine"}, ["'N'", "integer", "'nine'"]),
     ({"N": 2.5}, ["'N'", "integer"]),
     ({"N": 0}, ["'N'", ">= 1"]),
@@ -64,3 +65,20 @@ def test_schema_and_description_follow_the_dataclass():
     assert schema["properties"]["B"]["type"] == "array"
     assert schema["properties"]["k_drive"]["exclusiveMinimum"] == 0
     assert [row[0] for row in describe(Example)] == ["N", "k_drive", "drive", "creep", "B"]
+
+
+def test_an_extension_field_at_its_default_leaves_the_stored_parameters_and_the_id_alone():
+    from stickslip.registry import Plugin, run_id
+
+    @dataclasses.dataclass(frozen=True)
+    class Extended(Example):
+        law: str = param("cusp", "interface law", choices=("cusp", "smooth"), extension=True)
+
+    before, after = parse_params(Example, {"N": 27}), parse_params(Extended, {"N": 27})
+    assert params_to_dict(after) == params_to_dict(before)
+    plugin = Plugin(kind="solver", name="x", version="1", params=Example, run=None, summary="")
+    assert run_id(plugin, after) == run_id(plugin, before)
+    changed = parse_params(Extended, {"N": 27, "law": "smooth"})
+    assert params_to_dict(changed) == {**params_to_dict(before), "law": "smooth"}
+    assert run_id(plugin, changed) != run_id(plugin, before)
+    assert parse_params(Extended, params_to_dict(changed)) == changed  # stored and read back

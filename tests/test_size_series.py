@@ -8,9 +8,9 @@ import pytest
 
 from stickslip.events import fronts, plugin, size_series
 from stickslip.events.results import read_analysis_file
-from stickslip.events.shift_test import shift_test
+from stickslip.events.mean_shift import shift_test
 from stickslip.params import parse_params
-from test_events_extraction import history
+from test_events_extraction import history, run_attrs
 from test_fronts import C_D, C_S, H_BLOCK, SPACING, rupture
 
 K_DRIVE = {"stiff": 1e-3, "compliant": 1e-6}  # the paper's, at N = 1458
@@ -26,11 +26,10 @@ def single_slips(n, N, drops):
 
 
 def write_events(path, N, n, regime, seed, dt_scale, events):
-    attrs = {"N": N, "plates": n + 1, "k_drive": K_DRIVE[regime] * (1458 / N) ** 2, "seed": seed,
-             "params": {"dt_scale": dt_scale}}
+    attrs = run_attrs(N, n + 1, K_DRIVE[regime] * (1458 / N) ** 2, seed=seed, params={"dt_scale": dt_scale})
     tables = plugin.event_tables(history(N, events), N)
     plugin.write_event_file(tables, plugin.event_attrs(attrs, tables["increments"]), path, input=__file__)
-    return read_analysis_file(path, ("slip_interfaces", "periodicity"))
+    return read_analysis_file(path, "event-table", ("slip_interfaces", "periodicity"))
 
 
 @pytest.fixture(scope="module")
@@ -81,8 +80,7 @@ def test_periodicity_is_averaged_over_the_seeds_of_each_size(compliant):
 def test_front_speeds_count_only_meaningful_fits(tmp_path):
     N = 162
     rng = np.random.default_rng(12)
-    attrs = {"N": N, "plates": 3, "k_drive": K_DRIVE["stiff"] * (1458 / N) ** 2, "seed": 1, "c_s": C_S, "h": H_BLOCK,
-             "params": {"dt_scale": 4.0}}
+    attrs = run_attrs(N, 3, K_DRIVE["stiff"] * (1458 / N) ** 2, seed=1, c_s=C_S, h=H_BLOCK, params={"dt_scale": 4.0})
     speeds = {14: 1.5, 16: 1.9, 24: None}  # None: every block fails at once, no front
 
     def rerun(increment):
@@ -100,7 +98,7 @@ def test_front_speeds_count_only_meaningful_fits(tmp_path):
     path = tmp_path / "fronts.h5"
     fronts.write_front_file(failures, table, {**plugin.event_attrs(attrs, tables["increments"]),
                                               "interface_spacing": SPACING}, path, input=__file__)
-    row = size_series.front_speed_by_size([read_analysis_file(path, ("fronts",))]).iloc[0]
+    row = size_series.front_speed_by_size([read_analysis_file(path, "front-table", ("fronts",))]).iloc[0]
     assert (row["N"], row["dt_scale"], row["regime"], row["n"]) == (N, 4.0, "stiff", 2)
     assert (row["events"], row["ok"], row["flagged"]) == (3, 2, 1)
     assert row["c_f_mean"] == pytest.approx(1.7, rel=1e-3) and row["c_f_median"] == pytest.approx(1.7, rel=1e-3)

@@ -34,9 +34,11 @@ from scipy import stats
 
 from .. import h5io, registry
 from ..formats.analysis_file import write_analysis_file
+from ..formats.fem_run import RunFile, read_increments, read_run_attrs
+from ..formats.front_table import FAILURE_DTYPES, FORMAT, FRONT_DTYPES
 from ..h5io import FileFormatError
 from ..lineage import Artifact
-from ..mesh import interface_layer, load_mesh
+from ..mesh import interface_layer
 from ..params import ParameterError, param
 from ..progress import iterate
 from ..registry import register
@@ -52,18 +54,8 @@ VERSION = "2"  # 2: the two branches fitted separately (Theil-Sen), fits flagged
 #: The two branches of a front: towards increasing block index, and back.
 BRANCHES = ("right", "left")
 
+#: Columns of a replay's failure table (:meth:`stickslip.fem.replay.EventReplay.failures`).
 FAILURE_COLUMNS = ("a", "block", "t", "direction")
-
-#: Columns of the output table "failures" (one row per block failure) and their types.
-FAILURE_DTYPES = {"increment": "int64", "a": "int64", "block": "int64", "t": "float64", "direction": "int64"}
-
-#: Columns of the output table "fronts" (one row per re-run event), see :func:`analyse_event`.
-FRONT_DTYPES = {"increment": "int64", "s": "int64", "a_first": "int64", "a_second": "int64", "nucleation": "int64",
-                "meeting": "int64", "c_f": "float64", "fit": "object",
-                **{f"{column}_{side}": dtype for side in ("right", "left")
-                   for column, dtype in (("c_f", "float64"), ("t0", "float64"), ("points", "int64"),
-                                         ("r2", "float64"), ("quality", "object"))},
-                "t_first": "float64", "tau": "float64"}
 
 
 def _check_failures(failures, source):
@@ -373,7 +365,7 @@ def write_front_file(failures, fronts, attrs, output, *, input, params=FrontPara
         The analysed run file (its checksum goes into the header).
     params : FrontParams, optional
     """
-    write_analysis_file(output, "front-table", analysis=NAME, version=VERSION, params=params, input=input,
+    write_analysis_file(output, FORMAT, analysis=NAME, version=VERSION, params=params, input=input,
                         attrs=attrs, tables={"failures": failures, "fronts": fronts})
 
 
@@ -391,16 +383,11 @@ def _replay(input):
 @register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
-    from ..fem.output import read_increments, read_run_attrs
-
     replay = _replay(input)
     run_attrs = read_run_attrs(input)
-    for key in ("N", "h", "c_s"):
-        if key not in run_attrs:
-            raise FileFormatError(f"{input}: run attributes lack {key}")
     N = int(run_attrs["N"])
     with h5io.open_file(input) as file:
-        heights = load_mesh(file["mesh"]).layer_mid_height
+        heights = RunFile(file).mesh.layer_mid_height
     spacing = interface_spacing([heights[interface_layer(a)] for a in range(1, int(run_attrs["n_interfaces"]) + 1)])
     material = run_attrs.get("params", {})
     material = json.loads(material) if isinstance(material, str) else material

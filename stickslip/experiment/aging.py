@@ -212,26 +212,7 @@ def aging_rate(dmu, T, *, t0=T0):
     return np.where(T > t0, rate, np.nan)
 
 
-def spread_of_aging_rate(slips):
-    """Standard deviation of ``B_a`` per interface and ``n``, normalised by its ``n = 1`` value.
-
-    The ``n = 1`` reference of interface ``a`` is interface ``a`` driven alone: the slips of the
-    "individual" protocol for ``a``, or, if there are none, of the stack with ``n = 1``
-    (the same configuration for ``a = 1``).
-
-    Parameters
-    ----------
-    slips : pandas.DataFrame
-        Columns ``a``, ``n``, ``protocol``, ``B_a`` (NaN entries are ignored).
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns ``a``, ``n``, ``std`` (of ``B_a``), ``count``, ``std_normalised``
-        (``std / std`` of the reference; NaN without reference). The reference rows have
-        ``n = 1``.
-    """
-    valid = slips[np.isfinite(slips["B_a"].to_numpy(dtype=float))]
+def _spread(valid):
     individual = valid[valid["protocol"] == "individual"].assign(n=1)
     stack = valid[valid["protocol"] == "stack"]
     has_individual = set(individual["a"].unique())
@@ -240,6 +221,43 @@ def spread_of_aging_rate(slips):
              .agg(std=lambda b: b.std(ddof=1), count="size").reset_index())
     reference = table[table["n"] == 1].set_index("a")["std"]
     table["std_normalised"] = table["std"] / table["a"].map(reference)
+    return table
+
+
+def spread_of_aging_rate(slips):
+    """Standard deviation of ``B_a`` per interface and ``n``, normalised by its ``n = 1`` value.
+
+    The ``n = 1`` reference of interface ``a`` is interface ``a`` driven alone: the slips of the
+    "individual" protocol for ``a``, or, if there are none, of the stack with ``n = 1``
+    (the same configuration for ``a = 1``). Slips of all runs are pooled (the paper's 10 runs per n).
+
+    With a ``seed`` column and at least three seeds, the normalised standard deviation gets the
+    jackknife standard error over the seeds (each seed's runs, stack and individual, left out in
+    turn: ``sqrt((k - 1)/k sum_s (r_s - mean r)^2)``).
+
+    Parameters
+    ----------
+    slips : pandas.DataFrame
+        Columns ``a``, ``n``, ``protocol``, ``B_a`` (NaN entries are ignored), optionally ``seed``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``a``, ``n``, ``std`` (of ``B_a``), ``count``, ``std_normalised``
+        (``std / std`` of the reference; NaN without reference), ``std_normalised_error`` (NaN
+        without seeds). The reference rows have ``n = 1``.
+    """
+    valid = slips[np.isfinite(slips["B_a"].to_numpy(dtype=float))]
+    table = _spread(valid)
+    table["std_normalised_error"] = np.nan
+    seeds = sorted(valid["seed"].dropna().unique()) if "seed" in valid.columns else []
+    if len(seeds) >= 3:
+        key = ["a", "n"]
+        left_out = pd.concat([_spread(valid[valid["seed"] != seed]).assign(left_out=seed) for seed in seeds])
+        spread = left_out.groupby(key)["std_normalised"].agg(
+            lambda r: np.sqrt((len(seeds) - 1) / len(seeds) * np.sum((r - r.mean()) ** 2)) if len(r) == len(seeds)
+            else np.nan)
+        table["std_normalised_error"] = table.set_index(key).index.map(spread).to_numpy(dtype=float)
     return table
 
 

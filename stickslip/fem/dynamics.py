@@ -94,16 +94,16 @@ def residual(model, state):
 
 
 @njit
-def time_step(model, state, fe):
-    """Advance ``state`` by one time step ``model.dt`` (``fe``: [ni, 8] work array)."""
+def time_step(model, work, state):
+    """Advance ``state`` by one time step ``model.dt`` (``work``: the CPU backend's :class:`.backends.cpu.CpuWork`)."""
     state.t[0] += model.dt
     m = model
-    if m.nblock > 1:
-        _predict_parallel(m.nblock, m.dt, state.u, state.v, state.a)
+    if work.nblock > 1:
+        _predict_parallel(work.nblock, m.dt, state.u, state.v, state.a)
     else:
         _predict(0, m.ndof, m.dt, state.u, state.v, state.a)
-    compute_force(m, state, fe)
-    if m.nblock > 1:
-        _correct_parallel(m.nblock, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)
+    compute_force(m, work, state, True)
+    if work.nblock > 1:
+        _correct_parallel(work.nblock, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)
     else:
         _correct(0, m.ndof, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)

@@ -1,19 +1,21 @@
 """Equilibrium within fixed wells by direct solves with one factorisation per run (``relaxation = exact``).
 
 While no Gauss point changes well, the force is the gradient of a fixed energy:
-plates ``1/2 u^T K_p u``, every interface Gauss point the parabola of its current
-well ``K eps_m^2 + G (eps_eq - eps_min)^2`` (:mod:`.materials`), the drive springs
-(with a free lever the lever's moment balance). Its stiffness is constant up to one
-term: along the deviatoric direction of a Gauss point the cusp is as stiff as the
-plates (``G``), across it the curvature is ``G (1 - eps_min / eps_eq)`` (the bottom
-of a well is a circle of radius ``eps_min`` in the deviatoric plane). So the
-equilibrium ``f(u) = 0`` of the current wells is found by modified Newton
-iterations ``u <- u - A^-1 f(u)`` with the constant matrix
+plates ``1/2 u^T K_p u``, every interface Gauss point the potential of its current
+well ``K eps_m^2 + W(eps_eq)`` (:mod:`.laws`), the drive springs (with a free lever the
+lever's moment balance). The equilibrium ``f(u) = 0`` of the current wells is found by
+modified Newton iterations ``u <- u - A^-1 f(u)`` with the constant matrix
 
 ``A = K_p + K_i + U M U^T``
 
-on the free DOFs: ``K_i`` the interface elements with the elastic law (the radial
-curvature), ``U`` [nfree, nlayer] the layer-average weights ``w_l`` and ``M``
+on the free DOFs: ``K_i`` the interface elements made elastic with the law's
+``newton_moduli()``, moduli whose stiffness bounds the law's curvature from above (the cusp:
+along the deviatoric direction of a Gauss point as stiff as the plates, ``2 G`` in ``W''``,
+across it ``G (1 - eps_min / eps_eq)``, the bottom of a well being a circle of radius
+``eps_min`` in the deviatoric plane; the smooth law: ``2 G cos(theta) <= 2 G``). With
+``A >= H`` (``H`` the Hessian) the iterations contract towards a stable equilibrium and are
+repelled by unstable ones (an eigenvalue of ``A^-1 H`` below 0 makes ``I - A^-1 H`` expand),
+so an accepted solve is a local minimum of the energy. ``U`` [nfree, nlayer] the layer-average weights ``w_l`` and ``M``
 [nlayer, nlayer] the drive: ``k V_l`` on the diagonal (fixed lever), times
 ``I - r r^T / (1 + r.r)`` with a free lever (``r_l = h_l / H``). The periodic wrap is
 in the DOF numbering (images share a DOF). ``K_p + K_i`` is sparse, symmetric and
@@ -24,8 +26,11 @@ positive definite (the bottom edge is fixed): it is factorised once with SuperLU
 the exact stiffness and one iteration is the solution.
 
 The iterations stop when the relative residual (:func:`.dynamics.residual`, at rest)
-is below ``tol^2`` (the dynamic protocol's strict criterion), or when it has not halved
-in ``STALL`` consecutive iterations (round-off floor, or no convergence), or after
+is below ``tol^2`` (the dynamic protocol's strict criterion), or when no iteration of the last
+``STALL`` has halved the smallest residual and it is below ``tol`` (a round-off floor) or has not
+halved over those ``STALL`` iterations together either (no convergence; a law whose curvature is
+well below the matrix's, as the smooth law's beyond an inflection, contracts steadily but by less
+than half per iteration, and goes on), or after
 ``MAX_NEWTON`` iterations; the result counts only if its residual is below ``tol^2``, or
 below ``tol`` at a stall (a round-off floor above ``tol^2``, for a very small ``tol``). All operations are serial and in a fixed order: the result
 is the same bit for bit on every run.
@@ -36,8 +41,6 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from .assembly import assemble_csr, elastic_element_stiffness
-from .dynamics import residual
-from .forces import compute_force_in_wells, wells_hold
 
 __all__ = ["WellEquilibrium", "MAX_NEWTON", "STALL"]
 
@@ -57,9 +60,9 @@ class WellEquilibrium:
     Parameters
     ----------
     model : Model
-        Only its linear parts are used (plates, interface geometry and moduli, drive,
-        prescribed DOFs), so a model with other yield strains (e.g. all-elastic
-        interfaces) can share the factorisation.
+        Only its linear parts are used (plates, interface geometry, the law's
+        ``newton_moduli()``, drive, prescribed DOFs), so a model with other yield strains or
+        the elastic law (the linear response) can share the factorisation.
 
     Attributes
     ----------
@@ -73,7 +76,7 @@ class WellEquilibrium:
         ndof = model.ndof
         self.free = np.flatnonzero(~model.prescribed)
         plates = sp.csr_matrix((model.k_val, model.k_col, model.k_ptr), shape=(ndof, ndof))
-        ke = elastic_element_stiffness(model.iface_dNdx, model.iface_dV, model.K, model.G)
+        ke = elastic_element_stiffness(model.iface_dNdx, model.iface_dV, *model.law.newton_moduli())
         interfaces = sp.csr_matrix(assemble_csr(model.iface_dofs, ke, ndof)[::-1], shape=(ndof, ndof))
         self.matrix = (plates + interfaces)[self.free][:, self.free].tocsc()
         self._lu = splu(self.matrix, permc_spec="MMD_AT_PLUS_A")
@@ -121,7 +124,7 @@ class WellEquilibrium:
                 y -= c[layer] * self._Z[:, layer]
         return y
 
-    def relax(self, model, state, fe, tol):
+    def relax(self, model, state, backend, tol):
         """Equilibrium of the current wells from ``state`` (at rest), if it keeps every point in its well.
 
         Parameters
@@ -129,8 +132,8 @@ class WellEquilibrium:
         model : Model
         state : State
             Start (its ``u``, drive targets and ``idx`` are used; not modified).
-        fe : numpy.ndarray
-            [ni, 8] work array.
+        backend
+            Computes the forces (:mod:`.backends`).
         tol : float
             The minimisation tolerance; the solve ends below ``tol^2``.
 
@@ -144,18 +147,24 @@ class WellEquilibrium:
         trial = _copy_state(state)
         trial.v[:] = 0.0
         trial.a[:] = 0.0
-        compute_force_in_wells(model, trial, fe)
-        best = residual(model, trial)
-        stalled = 0
+        backend.force(model, trial, update_wells=False)
+        best = backend.residual(model, trial)
+        bests = [best]  # the smallest residual after each iteration
+        stalled = 0  # consecutive iterations that did not halve it
+        stuck = False
         for _ in range(MAX_NEWTON):
-            if best <= tol * tol or stalled >= STALL:
+            # stalled: no iteration halved the residual in the last STALL; stuck: not even all of them
+            # together, or the residual is below tol already (a round-off floor, accepted below)
+            stuck = stalled >= STALL and (best < tol or best > 0.5 * bests[-1 - STALL])
+            if best <= tol * tol or stuck:
                 break
             trial.u[self.free] -= self.solve(trial.f[self.free])
-            compute_force_in_wells(model, trial, fe)
-            current = residual(model, trial)
+            backend.force(model, trial, update_wells=False)
+            current = backend.residual(model, trial)
             stalled = 0 if current <= 0.5 * best else stalled + 1
             best = min(best, current)
-        final = residual(model, trial)
-        if not (final <= tol * tol or (stalled >= STALL and final < tol)):
+            bests.append(best)
+        final = backend.residual(model, trial)
+        if not (final <= tol * tol or (stuck and final < tol)):
             return None
-        return trial if wells_hold(model, trial) else None
+        return trial if backend.wells_hold(model, trial) else None

@@ -17,7 +17,8 @@ Reference: shared/reference-model.md, section 8a-8b.
 import numpy as np
 
 from ..numba_options import njit
-from .materials import equivalent_strain, well_index
+from .laws import well_index
+from .materials import equivalent_strain
 from .quad4 import element_strain
 
 __all__ = ["step_size", "autoscale", "BISECTION_RTOL", "MAX_BISECTIONS"]

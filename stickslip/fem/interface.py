@@ -1,11 +1,13 @@
-"""Interface elements' force, vectorised over elements.
+"""Interface elements' force, vectorised over elements, for any interface law.
 
-The cusp interface elements (one row of ``ni`` Quad4 elements per interface) are computed
-Gauss point by Gauss point as :func:`.quad4.element_strain`, :func:`.materials.well_index`
-and :func:`.materials.cusp_stress` prescribe, in the same order of operations (so the bits
-equal those of that scalar formulation), but with the elements as the inner, contiguous
-loop: the element data are stored field by field (:func:`interface_layout`) and one pass per
-Gauss point runs over the elements with loop-invariant rows, which LLVM vectorises.
+The interface elements (one row of ``ni`` Quad4 elements per interface) are computed
+Gauss point by Gauss point as :func:`.quad4.element_strain`, :func:`.laws.well_index`
+and :func:`.laws.well_stress` (the law's scalar reference) prescribe, in the same order of
+operations (so the bits equal those of that scalar formulation), but with the elements as the
+inner, contiguous loop: the element data are stored field by field (:func:`interface_layout`)
+and one pass per Gauss point runs over the elements with loop-invariant rows, which LLVM
+vectorises. The law (:mod:`.laws`) is an argument: the kernels are compiled for its type, with
+its stress factor inlined into the pass.
 
 A pass assumes that every Gauss point stays in its current well (the well's bounds are
 gathered first); the few elements where one leaves it get their well index updated and are
@@ -16,7 +18,8 @@ Reference: shared/reference-model.md, sections 2 and 4.
 import numpy as np
 
 from ..numba_options import njit
-from .materials import equivalent_strain, well_index
+from .laws import deviatoric_factor, well_index
+from .materials import equivalent_strain
 
 __all__ = ["interface_layout", "interface_force", "NIN", "NOUT"]
 
@@ -60,7 +63,7 @@ def _gather(lo, hi, iface_dofs, epsy, u, idx, inp):
 
 
 @njit
-def _pass(lo, hi, grad, volume, K, G, inp, out):
+def _pass(lo, hi, grad, volume, law, inp, out):
     # elements lo:hi; every row a slice (contiguous, non-negative index), few rows written per loop
     # (LLVM vectorises a loop only if it can check the overlaps of what it writes at run time)
     u0, u1, u2, u3 = inp[_U, lo:hi], inp[_U + 1, lo:hi], inp[_U + 2, lo:hi], inp[_U + 3, lo:hi]
@@ -78,14 +81,13 @@ def _pass(lo, hi, grad, volume, K, G, inp, out):
         bottom, top = inp[_LO + q, lo:hi], inp[_HI + q, lo:hi]
         sxx, syy, sxy = out[_SIG + 3 * q, lo:hi], out[_SIG + 3 * q + 1, lo:hi], out[_SIG + 3 * q + 2, lo:hi]
         outside = out[_OUT + q, lo:hi]
-        for e in range(hi - lo):  # stress in the current well (materials.cusp_stress)
+        for e in range(hi - lo):  # stress in the current well (laws.well_stress)
             xx, yy, xy = exx[e], eyy[e], exy[e]
             m = 0.5 * (xx + yy)
-            h = 0.5 * (xx - yy)
-            eq = np.sqrt(h * h + xy * xy)
-            factor = 0.0 if eq <= 0.0 else G * (1.0 - 0.5 * (bottom[e] + top[e]) / eq)
-            sxx[e] = K * m + factor * (xx - m)
-            syy[e] = K * m + factor * (yy - m)
+            eq = equivalent_strain(xx, yy, xy)
+            factor = deviatoric_factor(law, eq, bottom[e], top[e])
+            sxx[e] = law.K * m + factor * (xx - m)
+            syy[e] = law.K * m + factor * (yy - m)
             sxy[e] = factor * xy
             outside[e] = 0.0 if (bottom[e] < eq and eq <= top[e]) else 1.0
     w0, w1, w2, w3 = volume[0, lo:hi], volume[1, lo:hi], volume[2, lo:hi], volume[3, lo:hi]
@@ -107,21 +109,21 @@ def _pass(lo, hi, grad, volume, K, G, inp, out):
 
 
 @njit
-def interface_force(lo, hi, iface_dofs, grad, volume, epsy, K, G, u, idx, inp, out, update_wells):
+def interface_force(lo, hi, law, iface_dofs, grad, volume, epsy, u, idx, inp, out, update_wells):
     """Strain, stress and element force of the interface elements ``lo:hi`` (into ``out``).
 
     Parameters
     ----------
     lo, hi : int
         Element range.
+    law : tuple
+        The interface law (:mod:`.laws`), e.g. ``Cusp(K, G)``.
     iface_dofs : numpy.ndarray
         int64 [ni, 8] DOFs of the elements.
     grad, volume : numpy.ndarray
         [32, ni], [4, ni] (:func:`interface_layout`).
     epsy : numpy.ndarray
         [ni, ny] yield strains.
-    K, G : float
-        Moduli [stress].
     u : numpy.ndarray
         [ndof] displacement [length].
     idx : numpy.ndarray
@@ -133,7 +135,7 @@ def interface_force(lo, hi, iface_dofs, grad, volume, epsy, K, G, u, idx, inp, o
         Move a Gauss point to the well of its strain (else it keeps its well whatever its strain).
     """
     _gather(lo, hi, iface_dofs, epsy, u, idx, inp)
-    _pass(lo, hi, grad, volume, K, G, inp, out)
+    _pass(lo, hi, grad, volume, law, inp, out)
     if not update_wells:
         return
     for e in range(lo, hi):
@@ -148,4 +150,4 @@ def interface_force(lo, hi, iface_dofs, grad, volume, epsy, K, G, u, idx, inp, o
                     inp[_HI + q, e] = epsy[e, i + 1]
                     moved = True
         if moved:
-            _pass(e, e + 1, grad, volume, K, G, inp, out)
+            _pass(e, e + 1, grad, volume, law, inp, out)

@@ -55,16 +55,16 @@ def _grow(events, n):
 
 
 @njit
-def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record, quiet=0):
+def minimise(model, work, state, tol, niter_tol, max_iter, margin, record, quiet=0):
     """Minimise by time stepping (see module doc).
 
     Parameters
     ----------
     model : Model
+    work : CpuWork
+        The CPU backend's workspace (:mod:`.backends.cpu`).
     state : State
         Modified in place (forces must be up to date on entry).
-    fe : numpy.ndarray
-        [ni, 8] work array.
     tol : float
         Relative residual tolerance.
     niter_tol : int
@@ -99,7 +99,7 @@ def minimise(model, state, fe, tol, niter_tol, max_iter, margin, record, quiet=0
     events = np.empty((16 if record else 0, 3))
     nevent = 0
     for iiter in range(1, max_iter + 1):
-        time_step(model, state, fe)
+        time_step(model, work, state)
         if record:
             for e in range(ni):
                 hops = state.idx[e, 0] - previous[e]

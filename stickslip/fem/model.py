@@ -1,7 +1,10 @@
 """The discretised model as arrays (``Model``, fixed) and its mutable state (``State``).
 
 Both are named tuples of numpy arrays and scalars so that the numba kernels of
-:mod:`.forces`, :mod:`.dynamics` and :mod:`.minimise` take them whole.
+:mod:`.forces`, :mod:`.dynamics` and :mod:`.minimise` take them whole. The model is physics
+and discretisation only (operators, masses, the interfaces' geometry, law and yield
+strains, the drive); how its products are computed (threads, plate kernels, scratch) is a
+backend's (:mod:`.backends`).
 Units are the FE model's own: length (block size ``h = pi``), stress (``G = 1``),
 mass density (``rho = 1``), time (``dt = 0.05``; shear-wave speed ``c_s = sqrt(G / 2 / rho)``).
 """
@@ -12,26 +15,14 @@ import numpy as np
 
 from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, layer_average_weights,
                        lumped_diagonal)
-from .interface import NIN, NOUT, interface_layout
 from .quad4 import element_coordinates, shape_gradients
-from .structured import build_stencils, plan_blocks, plan_product
 
-__all__ = ["Model", "State", "PLATE_KERNELS", "build_model", "new_state"]
+__all__ = ["Model", "State", "build_model", "new_state"]
 
 Model = namedtuple("Model", [
     "ndof",           # int: number of DOFs
     "dt",             # float: time step [time]
     "k_ptr", "k_col", "k_val",  # CSR [ndof, ndof] elastic stiffness of the plates [stress] (k_col int32)
-    "structured",     # bool: plates by the stencils below (else by the CSR product, the reference)
-    "plate_views",    # int64 [nview, 4]: the structured product's plan (:class:`.structured.PlatePlan`)
-    "plate_groups",   # int64 [ngroup, 5]
-    "plate_triplet_ptr",   # int64 [ngroup + 1]
-    "plate_triplet_view",  # int64 [ntriplet, 3]
-    "plate_triplet_coef",  # float64 [ntriplet, 12]
-    "plate_empty",    # int64 [nempty]: DOFs with an empty plate row
-    "plate_work",     # float64 [4, nwork]: scratch of the structured product (views x, y; rows x, y)
-    "plate_view_blocks",   # int64 [nblock + 1]: view ranges of the parallel blocks (balanced)
-    "plate_group_blocks",  # int64 [nblock + 1]: group ranges of the parallel blocks (balanced)
     "mass_inv",       # float64 [ndof]: 1 / lumped mass on free DOFs, 0 on prescribed DOFs
     "damping",        # float64 [ndof]: lumped background damping [mass / time]
     "prescribed",     # bool [ndof]
@@ -39,12 +30,8 @@ Model = namedtuple("Model", [
     "iface_dofs",     # int64 [ni, 8]: DOFs of the interface elements (interface by interface, blocks left to right)
     "iface_dNdx",     # float64 [ni, 4, 4, 2] [1/length]
     "iface_dV",       # float64 [ni, 4] [length^2]
-    "iface_grad",     # float64 [32, ni]: iface_dNdx field by field (:func:`.interface.interface_layout`)
-    "iface_volume",   # float64 [4, ni]: iface_dV field by field
-    "iface_in",       # float64 [NIN, ni]: scratch of the interface kernel (:mod:`.interface`)
-    "iface_out",      # float64 [NOUT, ni]: its strain, stress and element force rows
+    "law",            # the interface law (:mod:`.laws`), e.g. Cusp(K, G)
     "epsy",           # float64 [ni, ny]: yield strains per interface element [strain]
-    "K", "G",         # float: moduli [stress]
     "layer_ptr",      # int64 [nlayer + 1]: slices of layer_xdofs / layer_w
     "layer_xdofs",    # int64 [sum m_l]
     "layer_w",        # float64 [sum m_l]: ubar_x = sum w u [1]
@@ -53,7 +40,6 @@ Model = namedtuple("Model", [
     "k_drive",        # float: spring stiffness per unit volume [stress / length^2]
     "free_lever",     # bool: targets follow the moment balance of a free lever
     "lever_ratio",    # float64 [nlayer]: h_l / H (free lever), layer height over drive height
-    "nblock",         # int: 1 = serial kernels; > 1 = parallel kernels over this many blocks
 ])
 
 State = namedtuple("State", [
@@ -68,12 +54,7 @@ State = namedtuple("State", [
 ])
 
 
-#: Plate kernels: periodic stencils over node lines (default), or the assembled CSR product (reference).
-PLATE_KERNELS = ("structured", "assembled")
-
-
-def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height,
-                threads=1, plate_kernel="structured"):
+def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height):
     """Assemble the model arrays of a layered mesh.
 
     Parameters
@@ -83,8 +64,9 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
         ``layer_is_plastic``, ``layer_mid_height``, ``interface_elements``.
     epsy : numpy.ndarray
         [n_interfaces * N, ny] yield strains, rows in ``interface_elements`` order.
-    K, G : float
-        Bulk-like and shear-like moduli (same in plates and interfaces) [stress].
+    law : tuple
+        The interface law (:mod:`.laws`); the plates are elastic with its moduli ``law.K``,
+        ``law.G`` [stress].
     rho, alpha : float
         Mass density and background damping density.
     dt : float
@@ -96,12 +78,6 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     free_lever : bool
     lever_height : float
         Height ``H`` of the drive spring on the lever (free lever only; > 0).
-    threads : int, optional
-        Number of threads of the parallel kernels (1: serial kernels). The results do
-        not depend on it.
-    plate_kernel : str, optional
-        One of :data:`PLATE_KERNELS`: the plates' product by stencils (:mod:`.structured`,
-        equal to the assembled product up to round-off) or by the assembled CSR matrix.
 
     Returns
     -------
@@ -120,15 +96,9 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
     if epsy.shape[0] != iface.size:
         raise ValueError(f"epsy has {epsy.shape[0]} rows; expected one per interface element ({iface.size})")
 
-    k_ptr, k_col, k_val = assemble_csr(edofs[elastic], elastic_element_stiffness(dNdx[elastic], dV[elastic], K, G),
-                                       ndof)
+    k_ptr, k_col, k_val = assemble_csr(edofs[elastic], elastic_element_stiffness(dNdx[elastic], dV[elastic], law.K,
+                                                                                 law.G), ndof)
     k_col = k_col.astype(np.int32)  # less memory traffic in the sparse product
-    if plate_kernel not in PLATE_KERNELS:
-        raise ValueError(f"plate_kernel {plate_kernel!r}: expected one of {PLATE_KERNELS}")
-    plan = plan_product(build_stencils(mesh, k_ptr, k_col, k_val), ndof)
-    iface_grad, iface_volume = interface_layout(dNdx[iface], dV[iface])
-    nblock = 4 * int(threads) if threads > 1 else 1
-    view_blocks, group_blocks = plan_blocks(plan, nblock)
     nelem = conn.shape[0]
     mass = lumped_diagonal(xe, edofs, np.full(nelem, rho), ndof)
     damping = lumped_diagonal(xe, edofs, np.full(nelem, alpha), ndof)
@@ -146,19 +116,13 @@ def build_model(mesh, *, epsy, K, G, rho, alpha, dt, k_drive, drive_active, free
         ptr.append(ptr[-1] + d.size)
     heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
     return Model(
-        ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, structured=plate_kernel == "structured",
-        plate_views=plan.views, plate_groups=plan.groups, plate_triplet_ptr=plan.triplet_ptr,
-        plate_triplet_view=plan.triplet_view, plate_triplet_coef=plan.triplet_coef, plate_empty=plan.empty_dofs,
-        plate_work=np.zeros((4, max(plan.view_size, plan.output_size))), plate_view_blocks=view_blocks,
-        plate_group_blocks=group_blocks,
-        mass_inv=mass_inv, damping=damping,
+        ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, mass_inv=mass_inv, damping=damping,
         prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
-        iface_dV=dV[iface], iface_grad=iface_grad, iface_volume=iface_volume, iface_in=np.zeros((NIN, iface.size)),
-        iface_out=np.zeros((NOUT, iface.size)), epsy=np.ascontiguousarray(epsy, dtype=np.float64), K=float(K), G=float(G),
+        iface_dV=dV[iface], law=law, epsy=np.ascontiguousarray(epsy, dtype=np.float64),
         layer_ptr=np.asarray(ptr, dtype=np.int64), layer_xdofs=np.concatenate(xdofs),
         layer_w=np.concatenate(weights), layer_volume=np.asarray(volume),
         drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),
-        lever_ratio=heights / float(lever_height), nblock=nblock)
+        lever_ratio=heights / float(lever_height))
 
 
 def new_state(model):

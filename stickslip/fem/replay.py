@@ -9,8 +9,10 @@ and runs the same kick and minimisation as the run (:meth:`.system.System.kick_a
 import numpy as np
 import pandas as pd
 
-from ..h5io import FileFormatError, open_file, read_table
-from .output import RunFile
+from ..formats.fem_run import RunFile
+from ..h5io import FileFormatError, open_file
+from .backends import make_backend
+from .parameters import stored_params
 from .system import System
 
 __all__ = ["EventReplay"]
@@ -23,6 +25,9 @@ class EventReplay:
     ----------
     path : str or os.PathLike
         A ``fem-run`` file.
+    backend : optional
+        How the numbers are computed (:mod:`.backends`); default: the run's own backend
+        (``params.backend``) with one thread, which reproduces the stored increments bit for bit.
 
     Notes
     -----
@@ -30,15 +35,15 @@ class EventReplay:
     stiffness) built, once; each :meth:`failures` costs one kick and one minimisation.
     """
 
-    def __init__(self, path):
+    def __init__(self, path, backend=None):
         self.path = path
         with open_file(path) as file:
             run = RunFile(file)
-            self.params, self.nstored = run.params, run.nstored
-            table = read_table(file, "increments", rows=run.nstored)
+            self.params, self.nstored = stored_params(file), run.nstored
+            table = run.increments()
             response = run.linear_response()
             self.N = run.mesh.N
-            self.system = System(run.params, run.mesh)
+            self.system = System(self.params, run.mesh, backend or make_backend(self.params.backend))
         self._kick = table["kick"].to_numpy(dtype=bool)
         self._yield_element = table["yield_element"].to_numpy(dtype=bool)
         self.system.set_linear_response(*response)

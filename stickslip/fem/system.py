@@ -12,17 +12,13 @@ import numpy as np
 
 from .equilibrium import WellEquilibrium
 from .event_driven import autoscale, step_size
-from .forces import compute_force
-from .minimise import CONVERGED, MARGIN, MAX_ITER_REACHED, QUIET, minimise
+from .laws import Cusp, make_law
+from .materials import equivalent_strains
+from .minimise import CONVERGED, MARGIN, MAX_ITER_REACHED, QUIET
 from .model import build_model, new_state
 from .yield_strains import HeldYieldStrains, interface_initstate, narrowest_well
 
 __all__ = ["System", "SolverError", "derived_constants"]
-
-
-def _equivalent(eps):
-    """Equivalent deviatoric strain of strains [..., 3] (xx, yy, xy)."""
-    return np.hypot(0.5 * (eps[..., 0] - eps[..., 1]), eps[..., 2])
 
 
 class SolverError(RuntimeError):
@@ -71,16 +67,17 @@ class System:
     Parameters
     ----------
     params : FemParams
+        The physics: the interface law is ``params.interface_law`` (:mod:`.laws`).
     mesh : stickslip.mesh.LayeredMesh
-    threads : int, optional
-        Threads of the parallel kernels (1: serial kernels); results do not depend on it.
-    plate_kernel : str, optional
-        ``"structured"`` (stencils, default) or ``"assembled"`` (the CSR product, the
-        reference): see :func:`.model.build_model`.
+    backend
+        How the numbers are computed (:mod:`.backends`, e.g. ``make_backend(params.backend,
+        threads)``); the system keeps it prepared for its model.
 
     Attributes
     ----------
     model : Model
+        Physics and discretisation; replaced (never modified) when the held yield strains move.
+    backend
     state : State
     constants : dict
         See :func:`derived_constants`.
@@ -90,7 +87,7 @@ class System:
         [ni, 4, 3], layer targets [nlayer], lever drive target (free lever).
     """
 
-    def __init__(self, params, mesh, threads=1, plate_kernel="structured"):
+    def __init__(self, params, mesh, backend):
         self.params = params
         self.mesh = mesh
         self.constants = derived_constants(params, mesh)
@@ -108,12 +105,12 @@ class System:
         self.drive_active = ~plastic & (np.arange(mesh.nlayer) > 0)
         self.heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
         c = self.constants
-        self.model = build_model(mesh, epsy=epsy, K=params.K, G=params.G, rho=params.rho, alpha=c["alpha"],
-                                 dt=c["dt"], k_drive=params.k_drive, drive_active=self.drive_active,
-                                 free_lever=params.drive == "free-lever", lever_height=c["H"], threads=threads,
-                                 plate_kernel=plate_kernel)
+        self.model = build_model(mesh, epsy=epsy, law=make_law(params.interface_law, params.K, params.G),
+                                 rho=params.rho, alpha=c["alpha"], dt=c["dt"], k_drive=params.k_drive,
+                                 drive_active=self.drive_active, free_lever=params.drive == "free-lever",
+                                 lever_height=c["H"])
+        self.backend = backend.prepare(self.model, mesh)
         self.state = new_state(self.model)
-        self._fe = np.zeros((self.model.iface_dofs.shape[0], 8))
         self.delta_u = self.delta_eps = self.delta_target = None
         self.delta_lever = 0.0
         self._equilibrium = None
@@ -123,7 +120,7 @@ class System:
 
     def refresh(self):
         """Recompute forces, interface strain/stress/indices and drive targets from ``state.u``."""
-        compute_force(self.model, self.state, self._fe)
+        self.backend.force(self.model, self.state)
 
     def restore(self, u, target, lever_target, t):
         """Set a stored state (at rest) and recompute everything that follows from it.
@@ -169,7 +166,7 @@ class System:
         """
         wells = self.wells
         if np.any((wells.offset > 0) & (self.state.idx.min(axis=1) == 0)
-                  & (_equivalent(self.state.eps).min(axis=1) <= wells.epsy[:, 0])):
+                  & (equivalent_strains(self.state.eps).min(axis=1) <= wells.epsy[:, 0])):
             wells.start(wells.epsy.shape[1] - 1)
             self._set_epsy()
             self.refresh()
@@ -180,7 +177,7 @@ class System:
             short = idx.max(axis=1) > ny - 1 - ahead
             if not short.any():
                 return
-            beyond = _equivalent(self.state.eps).max(axis=1) > wells.epsy[:, -1]
+            beyond = equivalent_strains(self.state.eps).max(axis=1) > wells.epsy[:, -1]
             shift = np.where(short, np.where(beyond, ny - 1 - behind, idx.min(axis=1) - behind), 0)
             if np.any(short & (shift <= 0)):
                 wells.widen(ny - 1)
@@ -204,22 +201,29 @@ class System:
             self._equilibrium = WellEquilibrium(self.model)
         return self._equilibrium
 
-    def relax_in_wells(self):
-        """Replace the state by the equilibrium of its current wells if every Gauss point stays in its well.
+    def relax_in_wells(self, model=None, state=None):
+        """Replace a state by the equilibrium of its current wells if every Gauss point stays in its well.
+
+        Parameters
+        ----------
+        model, state : optional
+            Default: the system's own.
 
         Returns
         -------
         bool
             True if the state (now at rest) was replaced.
         """
-        found = self.equilibrium.relax(self.model, self.state, self._fe, self.params.tol)
+        model = self.model if model is None else model
+        state = self.state if state is None else state
+        found = self.equilibrium.relax(model, state, self.backend, self.params.tol)
         if found is None:
             return False
         for name, value in zip(found._fields, found):
-            getattr(self.state, name)[...] = value
+            getattr(state, name)[...] = value
         return True
 
-    def minimise(self, margin=0, record=False):
+    def minimise(self, margin=0, record=False, model=None, state=None):
         """Minimise: the kick's relaxation (:func:`.minimise.minimise`, then with ``relaxation = exact`` solves).
 
         ``relaxation = dynamic``: damped dynamics until the residual criterion (the
@@ -237,6 +241,8 @@ class System:
             Stop when a Gauss point comes within this many wells of the end of its sequence.
         record : bool, optional
             Record the well changes of Gauss point 0 (see :func:`.minimise.minimise`).
+        model, state : optional
+            Default: the system's own (the linear response minimises an elastic model in a state of its own).
 
         Returns
         -------
@@ -250,13 +256,15 @@ class System:
         SolverError
             If ``max_iter`` steps do not converge.
         """
+        model = self.model if model is None else model
+        state = self.state if state is None else state
         p = self.params
         quiet = self.constants["quiet_steps"] if p.relaxation == "exact" else 0
         total = 0
         found = []
         while True:
-            status, niter, events = minimise(self.model, self.state, self._fe, p.tol, p.niter_tol,
-                                             p.max_iter - total, margin, record, quiet)
+            status, niter, events = self.backend.minimise(model, state, p.tol, p.niter_tol, p.max_iter - total,
+                                                          margin, record, quiet)
             total += niter
             found.append(events)
             events = np.concatenate(found) if len(found) > 1 else events
@@ -264,7 +272,7 @@ class System:
                 raise SolverError(f"minimisation did not converge in max_iter = {p.max_iter} steps")
             if status == MARGIN:
                 return 0, events
-            if quiet and self.relax_in_wells():
+            if quiet and self.relax_in_wells(model, state):
                 return total, events
             if status == CONVERGED:
                 return total, events
@@ -276,33 +284,28 @@ class System:
         Fixed lever: targets ``2 eps0 H_l`` (affine simple shear ``gamma = eps0``);
         free lever: lever drive target ``eps0``. ``relaxation = dynamic``: minimised from
         rest by damped dynamics (the paper's protocol); ``exact``: one direct solve with
-        the run's factorisation (the model is linear). Then scaled so that the largest
-        interface equivalent strain is 0.1 of the narrowest well. The current state is
-        not changed.
+        the run's factorisation (the model is linear). The interfaces are elastic, whatever the
+        run's law: the cusp law in one infinitely wide well centred on zero strain, which is linear
+        elasticity bit for bit (``G (1 - 0 / eps_eq) = G``) and needs no kernels compiled for
+        another law type, in a model and state of their own. Then scaled so that the largest interface equivalent strain is
+        0.1 of the narrowest well. The system's model and state are not changed.
         """
         huge = np.finfo(np.float64).max
-        elastic = self.model._replace(epsy=np.tile(np.array([[-huge, huge]]), (self.model.epsy.shape[0], 1)))
-        saved = self.state
-        self.state = new_state(elastic)
+        elastic = self.model._replace(law=Cusp(self.params.K, self.params.G),
+                                      epsy=np.tile(np.array([[-huge, huge]]), (self.model.epsy.shape[0], 1)))
+        state = new_state(elastic)
         unit_target = 2.0 * self.params.eps0 * self.heights
-        self.state.target[:] = unit_target
-        self.state.lever[0] = self.params.eps0
-        model = self.model
-        self.model = elastic
-        try:
-            self.refresh()
-            if self.params.relaxation == "exact":
-                if not self.relax_in_wells():
-                    raise SolverError("the direct solve of the linear response did not converge")
-            else:
-                self.minimise()
-            u, eps = self.state.u.copy(), self.state.eps.copy()
-        finally:
-            self.model = model
-            self.state = saved
-        scale = autoscale(self.narrowest_well, eps)
+        state.target[:] = unit_target
+        state.lever[0] = self.params.eps0
+        self.backend.force(elastic, state)
+        if self.params.relaxation == "exact":
+            if not self.relax_in_wells(elastic, state):
+                raise SolverError("the direct solve of the linear response did not converge")
+        else:
+            self.minimise(model=elastic, state=state)
+        scale = autoscale(self.narrowest_well, state.eps)
         lever = scale * self.params.eps0 if self.model.free_lever else 0.0
-        self.set_linear_response(scale * u, scale * eps, scale * unit_target, lever)
+        self.set_linear_response(scale * state.u, scale * state.eps, scale * unit_target, lever)
 
     def set_linear_response(self, delta_u, delta_eps, delta_target, delta_lever):
         """Set a (stored) scaled linear response; see the class attributes."""

@@ -7,10 +7,11 @@ Every function draws on a given :class:`matplotlib.axes.Axes` and sets its label
 """
 
 import numpy as np
+import pandas as pd
 from matplotlib.ticker import NullFormatter
 
 from ..experiment import aging, kinematics
-from .plotting import a_style, individual_style, n_style, plot_density
+from .plotting import a_style, hollow, individual_style, n_style, plot_against_n, plot_density
 from .style import interface_color
 
 __all__ = ["LABELS", "single_slips", "distributions_by_n", "aging_panel",
@@ -30,8 +31,8 @@ def single_slips(slips, protocol=None):
 
 
 def distributions_by_n(ax, slips, a, column, edges, *, individual=True, logarithmic=False):
-    """``P(column)`` of the single slips of interface ``a``: one line per ``n``, the interface
-    driven alone in black.
+    """``P(column)`` of the single slips of interface ``a``: one line per ``n`` (``gid`` "n=<n>"), the
+    interface driven alone in black (``gid`` "reference"; every seed's slips pooled).
 
     Parameters
     ----------
@@ -51,10 +52,10 @@ def distributions_by_n(ax, slips, a, column, edges, *, individual=True, logarith
         decades, such as ``T_a``; ``edges`` then logarithmic).
     """
     single = single_slips(slips)
-    groups = [(stack_n, n_style(stack_n), {}) for stack_n in
+    groups = [(stack_n, n_style(stack_n), {"gid": f"n={stack_n}"}) for stack_n in
               sorted(single.loc[(single["protocol"] == "stack") & (single["a"] == a), "n"].unique())]
     if individual:
-        groups.append((None, individual_style(), {"linestyle": "--"}))
+        groups.append((None, individual_style(), {"linestyle": "--", "gid": "reference"}))
     for n, style, extra in groups:
         part = single[(single["a"] == a) & ((single["protocol"] == "individual") if n is None
                                             else (single["protocol"] == "stack") & (single["n"] == n))]
@@ -147,26 +148,49 @@ def disorder_law_lines(ax, slips, T_range):
                 label=r"$\Delta\mu_a = K T_a h \dot\gamma / N$" if index == 0 else None)
 
 
-def slow_slip_fraction_panel(ax, interfaces):
-    """``R_slow`` against ``n`` per interface: mean over runs, error bars from min to max.
+def slow_slip_fraction_panel(ax, interfaces, shuffled=None):
+    """``R_slow`` against ``n`` per interface: mean over the runs, error bars = standard error of that
+    mean (over the runs: the seeds), lines only between neighbouring ``n``.
 
     Parameters
     ----------
     ax : matplotlib.axes.Axes
     interfaces : pandas.DataFrame
-        :func:`~stickslip.figures.experimental_data.load_interfaces` of the stack runs.
+        :func:`~stickslip.figures.experimental_data.load_interfaces` of the stack runs in order.
+    shuffled : pandas.DataFrame, optional
+        The same of runs with the slabs shuffled (the paper's control): drawn open at ``n + 0.3``
+        (``gid`` "shuffled"), per interface (position), with their slab order in the legend.
+
+    Returns
+    -------
+    pandas.DataFrame
+        What is drawn: ``a``, ``n``, ``mean``, ``sem``, ``runs``, ``shuffled``.
     """
-    stack = interfaces[(interfaces["protocol"] == "stack") & interfaces["driven"].to_numpy(dtype=bool)]
-    for a, part in stack.groupby("a"):
-        summary = part.groupby("n")["R_slow"].agg(["mean", "min", "max"]).reset_index()
-        offset = 0.06 * (a - 3)
-        ax.errorbar(summary["n"] + offset, summary["mean"],
-                    yerr=[summary["mean"] - summary["min"], summary["max"] - summary["mean"]],
-                    capsize=2, markersize=4, **a_style(a))
+    drawn = []
+    for table, is_shuffled in ((interfaces, False), (shuffled, True)):
+        if table is None or table.empty:
+            continue
+        stack = table[(table["protocol"] == "stack") & table["driven"].to_numpy(dtype=bool)]
+        for a, part in stack.groupby("a"):
+            summary = part.groupby("n")["R_slow"].agg(mean="mean", sem="sem", runs="size").reset_index()
+            drawn.append(summary.assign(a=a, shuffled=is_shuffled))
+            style = a_style(a)
+            if is_shuffled:
+                ax.errorbar(summary["n"] + 0.3, summary["mean"], yerr=summary["sem"].fillna(0.0), linestyle="none",
+                            capsize=2, gid="shuffled", **{**hollow(style, 5.0), "label": None})
+            else:
+                plot_against_n(ax, summary["n"] + 0.06 * (a - 3), summary["mean"], summary["sem"].fillna(0.0),
+                               markersize=4, **style)
+        if is_shuffled:
+            orders = sorted(stack["slab_order"].unique())
+            ax.plot([], [], linestyle="none", **{**hollow({"color": "grey", "marker": "o"}, 5.0),
+                                                  "label": f"shuffled ({'; '.join(orders)}), at $n + 0.3$"})
     ax.axhline(0.0, color="grey", linewidth=0.5)
     ax.set_xlabel("$n$")
     ax.set_ylabel(r"$R_\mathrm{slow}$")
-    ax.set_xticks(sorted(stack["n"].unique()))
+    ax.set_xticks(sorted(interfaces["n"].unique()))
+    columns = ["a", "n", "mean", "sem", "runs", "shuffled"]
+    return pd.concat(drawn, ignore_index=True)[columns] if drawn else pd.DataFrame(columns=columns)
 
 
 def positions_panel(ax, record, interfaces, t_range):

@@ -9,11 +9,11 @@ from matplotlib.ticker import NullFormatter
 from .. import registry
 from ..params import param
 from .experimental_data import EVENTS, example_run, excerpt, load_slips
-from .plotting import a_style, label_panels, linear_edges
+from .plotting import a_style, hollow, label_panels, legend_outside, linear_edges
 from .experimental_panels import LABELS, distributions_by_n, positions_panel, single_slips
 from .style import interface_color, plt, save_figure
 
-VERSION = "1"
+VERSION = "2"  # 2: legends beside the panels, open markers of distinct shapes and sizes in (c)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -39,16 +39,18 @@ def force_panel(ax, record, slips, t_range):
     for a in sorted(shown["a"].unique()):
         ax.plot([], [], color=interface_color(a), linewidth=2.0, label=f"$a = {a}$")
     ax.set_ylabel("$F$ (N)")
-    ax.legend(fontsize=7, ncol=5, loc="upper left", handlelength=1.0, columnspacing=0.8, frameon=False,
-              bbox_to_anchor=(0.08, 1.0))
+    legend_outside(ax, handlelength=1.0)
 
 
-@registry.register("figure", "fig3", VERSION, Fig3Params, inputs=(EVENTS,))
-def run(params, inputs, output):
-    """Fig. 3: F(t) and R_i(t) excerpt, P(dF) for a = 1 and every n, dR_a measured vs from dF."""
+#: Marker size [pt] of interface a = 1 in panel (c); each next interface is smaller by MARKER_STEP.
+MARKER_SIZE, MARKER_STEP = 4.5, 0.5
+
+
+def draw(params, inputs):
+    """The figure (not saved): what :func:`run` writes; the tests read its plotted data."""
     slips = load_slips(inputs[EVENTS])
     record, run_slips = example_run(slips, inputs[EVENTS], n=params.n_example)
-    fig = plt.figure(figsize=(8.0, 5.0), layout="constrained")
+    fig = plt.figure(figsize=(9.5, 5.0), layout="constrained")
     grid = fig.add_gridspec(2, 2, width_ratios=(1.5, 1.0))
     ax_F = fig.add_subplot(grid[0, 0])
     ax_R = fig.add_subplot(grid[1, 0], sharex=ax_F)
@@ -56,22 +58,22 @@ def run(params, inputs, output):
     ax_dR = fig.add_subplot(grid[1, 1])
     t_range = excerpt(record, params.t_from, params.duration)
     force_panel(ax_F, record, run_slips, t_range)
-    ax_F.text(0.98, 0.97, f"$n = {record.n}$", transform=ax_F.transAxes, ha="right", va="top", fontsize=9)
+    ax_F.set_title(f"$n = {record.n}$", loc="right", fontsize=9)
     ax_F.tick_params(labelbottom=False)
     positions_panel(ax_R, record, range(1, record.n_slabs + 1), t_range)
-    ax_R.legend(fontsize=7, ncol=5, loc="upper left", handlelength=1.0, columnspacing=0.8, frameon=False,
-                bbox_to_anchor=(0.08, 1.0))
+    legend_outside(ax_R, handlelength=1.0)
 
     stack = single_slips(slips, "stack")
     one = stack[stack["a"] == 1]
     distributions_by_n(ax_dF, slips, 1, "dF", linear_edges(one["dF"], 30), individual=False)
-    ax_dF.legend(fontsize=7, title="$a = 1$", title_fontsize=7)
+    legend_outside(ax_dF, title="$a = 1$")
 
-    for a in sorted(stack["a"].unique()):
+    # Open markers, a shape and a size per interface, translucent, the most numerous drawn first: overlaps stay
+    # legible.
+    for a in stack["a"].value_counts().index:
         part = stack[stack["a"] == a]
-        ax_dR.plot(part["dR_from_dF"], part["dR"], linestyle="none", markersize=2.5, alpha=0.4,
-                   markeredgewidth=0, **{**a_style(a), "label": None})
-        ax_dR.plot([], [], linestyle="none", markersize=4, **a_style(a))
+        ax_dR.plot(part["dR_from_dF"], part["dR"], linestyle="none", gid=f"a={a}", alpha=0.6,
+                   **{**hollow(a_style(a), MARKER_SIZE - MARKER_STEP * (a - 1)), "markeredgewidth": 0.6})
     limits = np.array([np.nanmin(stack[["dR", "dR_from_dF"]].to_numpy()), np.nanmax(stack[["dR", "dR_from_dF"]].to_numpy())])
     limits = np.array([max(limits[0], 1e-3) / 1.2, limits[1] * 1.2])
     ax_dR.plot(limits, limits, color="black", linewidth=0.8, linestyle="--", label=r"$y = x$")
@@ -83,6 +85,16 @@ def run(params, inputs, output):
     ax_dR.set_ylim(limits)
     ax_dR.set_xlabel(LABELS["dR_from_dF"])
     ax_dR.set_ylabel(r"$\Delta R_a$ measured (mm)")
-    ax_dR.legend(fontsize=7, loc="upper left")
+    entries = sorted(zip(*ax_dR.get_legend_handles_labels()), key=lambda entry: (entry[1] == r"$y = x$", entry[1]))
+    legend_outside(ax_dR, handles=[handle for handle, _ in entries], labels=[label for _, label in entries])
     label_panels([ax_F, ax_dF, ax_dR])
-    save_figure(fig, output)
+    return fig
+
+
+@registry.register("figure", "fig3", VERSION, Fig3Params, inputs=(EVENTS,),
+                   summary="Fig. 3: (a) F(t) with the force drops coloured by interface, and R_i(t), of the first "
+                           "stack run of n_example; (b) P(dF) of a = 1 for every n; (c) dR_a measured against dR_a "
+                           "from dF, every stack slip (open markers, one shape and size per interface)")
+def run(params, inputs, output):
+    """Fig. 3: F(t) and R_i(t) excerpt, P(dF) for a = 1 and every n, dR_a measured vs from dF."""
+    save_figure(draw(params, inputs), output)

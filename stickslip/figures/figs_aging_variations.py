@@ -7,11 +7,11 @@ from .. import registry
 from ..experiment.aging import without_slow_slip
 from ..params import param
 from .experimental_data import EVENTS, load_slips
-from .plotting import individual_style, label_panels
+from .plotting import individual_style, label_panels, legend_outside
 from .experimental_panels import aging_panel, disorder_law_lines, single_slips
 from .style import plt, save_figure
 
-VERSION = "2"
+VERSION = "3"  # 3: legends beside the panels
 
 
 @dataclasses.dataclass(frozen=True)
@@ -21,13 +21,12 @@ class FigsAgingVariationsParams:
     t0: float = param(1.0, "time scale T0 of the aging law", unit="s", exclusive_minimum=0)
 
 
-@registry.register("figure", "figS-aging-variations", VERSION, FigsAgingVariationsParams, inputs=(EVENTS,))
-def run(params, inputs, output):
-    """SI aging variations: dmu_a(T_a) by interface, by n, with individual slips, without slow slip."""
+def draw(params, inputs):
+    """The figure (not saved): what :func:`run` writes."""
     slips = load_slips(inputs[EVENTS])
     stack = single_slips(slips, "stack")
     alone = single_slips(slips, "individual")
-    fig, axes = plt.subplots(2, 2, figsize=(8.0, 6.4), layout="constrained")
+    fig, axes = plt.subplots(2, 2, figsize=(10.0, 6.4), layout="constrained")
     aging_panel(axes[0, 0], stack, color_by="a", t0=params.t0)
     aging_panel(axes[0, 1], stack, color_by="n", t0=params.t0)
     fit = aging_panel(axes[1, 0], stack, color_by="n", t0=params.t0)
@@ -43,6 +42,16 @@ def run(params, inputs, output):
         for ax in axes.ravel():
             ax.set_ylim(bottom=0)
     for ax in axes.ravel():
-        ax.legend(fontsize=5.5, ncol=3, frameon=False, loc="upper left")
+        legend_outside(ax, fontsize=5.5)
     label_panels(axes)
-    save_figure(fig, output)
+    return fig
+
+
+@registry.register("figure", "figS-aging-variations", VERSION, FigsAgingVariationsParams, inputs=(EVENTS,),
+                   summary="SI aging variations: dmu_a against T_a of every stack slip (a) by interface, (b) by n, "
+                           "(c) with the slips of the interfaces driven alone (black, every seed) and the disorder "
+                           "law, (d) without the slips after slow slip; log-binned means (error bars: standard "
+                           "deviation in the bin), fits through the origin (dotted) and with an intercept (dashed)")
+def run(params, inputs, output):
+    """SI aging variations: dmu_a(T_a) by interface, by n, with individual slips, without slow slip."""
+    save_figure(draw(params, inputs), output)

@@ -9,11 +9,11 @@ from matplotlib.ticker import NullFormatter
 from .. import registry
 from ..params import param
 from .experimental_data import EVENTS, load_slips
-from .plotting import a_style, label_panels, linear_edges, plot_density
+from .plotting import a_style, label_panels, legend_outside, linear_edges, plot_density
 from .experimental_panels import LABELS, single_slips
 from .style import plt, save_figure
 
-VERSION = "1"
+VERSION = "2"  # 2: legends beside the panels; every seed of the individual protocol
 
 
 @dataclasses.dataclass(frozen=True)
@@ -23,11 +23,10 @@ class FigsIndividualParams:
     bins: int = param(30, "bins of P(dF) and P(dmu_a), from 0 to the 99.5th percentile", minimum=2)
 
 
-@registry.register("figure", "figS-individual", VERSION, FigsIndividualParams, inputs=(EVENTS,))
-def run(params, inputs, output):
-    """SI individual sliding: dR_a vs dR_a(dF), P(dF) and P(dmu_a) per interface driven alone."""
+def draw(params, inputs):
+    """The figure (not saved): what :func:`run` writes; the tests read its plotted data."""
     alone = single_slips(load_slips(inputs[EVENTS]), "individual")
-    fig, axes = plt.subplots(1, 3, figsize=(10.0, 3.2), layout="constrained")
+    fig, axes = plt.subplots(1, 3, figsize=(11.0, 3.2), layout="constrained")
     interfaces = sorted(alone["a"].unique())
     for a in interfaces:
         part = alone[alone["a"] == a]
@@ -44,11 +43,19 @@ def run(params, inputs, output):
     for column, ax in zip(("dF", "dmu"), axes[1:]):
         edges = linear_edges(alone[column], params.bins)
         for a in interfaces:
-            plot_density(ax, alone.loc[alone["a"] == a, column], edges, **a_style(a))
+            plot_density(ax, alone.loc[alone["a"] == a, column], edges, gid=f"a={a}", **a_style(a))
         ax.set_xlabel(LABELS[column])
         ax.set_ylabel(f"$P$({LABELS[column].split(' (')[0]})")
     for ax in axes:
         ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.legend(fontsize=6.5, frameon=False, title="$n = 1$ (individual)", title_fontsize=6.5)
+    legend_outside(axes[-1], title="$n = 1$ (individual)")
     label_panels(axes)
-    save_figure(fig, output)
+    return fig
+
+
+@registry.register("figure", "figS-individual", VERSION, FigsIndividualParams, inputs=(EVENTS,),
+                   summary="SI individual sliding: (a) dR_a measured against dR_a from dF, (b) P(dF) and (c) "
+                           "P(dmu_a) of each interface driven alone (every seed pooled)")
+def run(params, inputs, output):
+    """SI individual sliding: dR_a vs dR_a(dF), P(dF) and P(dmu_a) per interface driven alone."""
+    save_figure(draw(params, inputs), output)

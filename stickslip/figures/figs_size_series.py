@@ -32,7 +32,7 @@ NAME = "figS-size-series"
 #: The paper's system size, and its front speed [c_s].
 PAPER_N, PAPER_C_F = 1458, 2.0
 
-#: Standard errors in the detectable shift of :func:`stickslip.events.shift_test.detectable_shift`
+#: Standard errors in the detectable shift of :func:`stickslip.events.mean_shift.detectable_shift`
 #: (z_0.975 + z_0.8): the shift's standard error is the detectable shift over this.
 DETECTABLE_IN_ERRORS = 2.8016
 

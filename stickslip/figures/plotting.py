@@ -1,6 +1,7 @@
 """Plot helpers shared by every figure: the bins (one place: :func:`range_edges`,
 :func:`linear_edges`, :func:`log_edges`), probability densities, the style of ``n`` and ``a``,
-and panel letters.
+values against ``n`` (lines only between neighbouring ``n``), legends beside the axes, and panel
+letters.
 """
 
 import numpy as np
@@ -8,7 +9,7 @@ import numpy as np
 from .style import N_MARKERS, interface_color, n_color
 
 __all__ = ["density", "plot_density", "range_edges", "linear_edges", "log_edges", "n_style",
-           "individual_style", "a_style", "label_panels"]
+           "individual_style", "a_style", "hollow", "plot_against_n", "legend_outside", "label_panels"]
 
 
 def range_edges(values, bins):
@@ -126,6 +127,50 @@ def individual_style():
 def a_style(a):
     """Colour, marker and label of interface ``a``."""
     return {"color": interface_color(a), "marker": N_MARKERS[(int(a) - 1) % len(N_MARKERS)], "label": f"$a = {int(a)}$"}
+
+
+def hollow(style, size=4.0):
+    """``style`` (of :func:`a_style` or :func:`n_style`) with open markers of ``size`` [pt]: markers of
+    different shapes and sizes stay distinguishable where they overlap."""
+    return {**style, "markerfacecolor": "none", "markeredgecolor": style["color"], "markersize": size,
+            "markeredgewidth": 0.8}
+
+
+def plot_against_n(ax, n, values, errors=None, **style):
+    """Values measured at integer ``n``: markers at every point (with error bars if ``errors``), lines
+    only between neighbouring ``n`` (``n`` and ``n + 1`` both measured), so that no line crosses an
+    ``n`` that was not measured.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    n, values : array_like
+        Shape [k], ``n`` increasing (integers, or integers plus a common offset).
+    errors : array_like, optional
+        Half-lengths of the error bars, shape [k].
+    **style
+        Colour, marker, label (:func:`a_style`); the label goes to the markers only.
+
+    Returns
+    -------
+    matplotlib.container.ErrorbarContainer or matplotlib.lines.Line2D
+        The markers.
+    """
+    n, values = np.asarray(n, dtype=float), np.asarray(values, dtype=float)
+    line_style = {key: value for key, value in style.items() if key in ("color", "linewidth", "linestyle")}
+    breaks = np.flatnonzero(np.diff(n) != 1.0) + 1
+    for part in np.split(np.arange(n.size), breaks):
+        if part.size > 1:
+            ax.plot(n[part], values[part], marker="none", **{"linewidth": 1.0, **line_style})
+    if errors is None:
+        return ax.plot(n, values, linestyle="none", **style)[0]
+    return ax.errorbar(n, values, yerr=errors, linestyle="none", capsize=2, **style)
+
+
+def legend_outside(ax, **options):
+    """The legend of ``ax`` beside it, to the right (off the data), without a frame."""
+    return ax.legend(**{"loc": "upper left", "bbox_to_anchor": (1.02, 1.0), "borderaxespad": 0.0, "frameon": False,
+                        "fontsize": 6.5, "title_fontsize": 6.5, **options})
 
 
 def label_panels(axes, letters="abcdefghijklmnopqrstuvwxyz"):

@@ -3,12 +3,13 @@
 Parameters: :class:`stickslip.fem.parameters.FemParams` (every field documented
 with its unit; ``stickslip plugins --params`` lists them). The mesh is read from
 ``inputs["mesh"]`` (a file of :func:`stickslip.mesh.write_mesh`) when given, else
-built from ``N`` and ``plates``. The output file (layout: :mod:`stickslip.fem.output`)
+built from ``N`` and ``plates``. The output file (format ``fem-run``, :mod:`stickslip.formats.fem_run`)
 is appended after every increment; an existing incomplete file with the same
 parameters is resumed, a completed one is left as it is.
 """
 
 from .. import registry
+from ..fem.backends import make_backend
 from ..fem.parameters import FemParams
 from ..fem.replay import EventReplay
 from ..fem.run import run_simulation
@@ -52,4 +53,5 @@ def stack_mesh(params, inputs):
 @registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads=1, inputs=None):
     """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
-    run_simulation(params, output, stack_mesh(params, inputs), threads=threads, producer=("fem", VERSION))
+    run_simulation(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
+                   producer=("fem", VERSION))

@@ -13,47 +13,42 @@ with ``S_k`` the spring forces on its driven slabs (:meth:`.apparatus.Apparatus.
 (:class:`.rate_state.RateStateLaw`; the same normal force ``N`` on every interface, as in the
 statics), whose ``mu0`` may vary along the slip path (:mod:`.slip_path`). In quasi-static equilibrium ``mu_k`` equals the apparatus's ``mu_i = sum_{j >= i} f_j / N``.
 
-State vector ``y = [R_S, V_S, psi_S, gamma]`` (3 m + 1 values, :mod:`.slab_equations`): slips
-[mm], slip rates [mm/s], ``psi = ln(V0 theta / D_c)``, lever rotation [rad]. The system is very
-stiff while the interfaces stick (the friction's stiffness ``N a / V`` with ``V`` down to nm/s
-gives rates ~1e12 /s) and fast during a slip (ms), so it is integrated with an implicit method
-with the analytic Jacobian: the compiled L-stable Rosenbrock method RODAS4 of :mod:`.rosenbrock`
-(default), or ``scipy.integrate.solve_ivp``'s Radau, BDF, LSODA (same results, ~1000 times slower a
-step in Python); an explicit method would need time steps below 1e-12 s.
+State vector ``y = [R_S, mu_S, psi_S, gamma]`` (3 m + 1 values, :mod:`.slab_equations`): slips
+[mm], friction coefficients, ``psi = ln(V0 theta / D_c)``, lever rotation [rad]; the slip rates are
+functions of the state (:meth:`SlabDynamics.slip_rates`). The friction, not the slip rate, is the
+state because the stick's force balance is linear in it (:mod:`.slab_equations` says why that makes
+the integration fail-safe). The system is very stiff while the interfaces stick (the friction's
+stiffness ``N a / V`` with ``V`` down to 1e-17 mm/s gives rates up to ~1e19 /s) and fast during a
+slip (ms), so it is integrated with an implicit method with the analytic Jacobian: the compiled
+L-stable Rosenbrock method RODAS4 of :mod:`.rosenbrock` (default), or ``scipy.integrate.solve_ivp``'s
+Radau (~1000 times slower a step in Python); an explicit method would need time steps below 1e-12 s.
+scipy's BDF and LSODA are not offered: their Newton iterations factorise ``I - h J`` without
+equilibrating its rows, which span ~19 orders of magnitude in a stick (:mod:`.slab_linear_system`);
+BDF's step size underflows and LSODA skips slips (individual protocol, a = 1).
 
 Units: lengths [mm], forces [N], masses [kg] (accelerations ``1000 F / M`` [mm/s^2]), time [s].
 """
 
 import dataclasses
 import math
-import sys
 from typing import NamedTuple
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ... import progress
 from . import rosenbrock
-from .slab_equations import friction as _friction, jacobian as _jacobian, rhs as _rhs
+from .slab_equations import jacobian as _jacobian, rhs as _rhs, slip_rates as _slip_rates
 from .slip_path import no_path
 
-__all__ = ["SlabDynamics", "Trajectory", "METHODS", "DEFAULT_METHOD", "FALLBACK"]
+__all__ = ["SlabDynamics", "Trajectory", "METHODS", "DEFAULT_METHOD"]
 
-#: Implicit methods: the numba-compiled Rosenbrock methods, and those of scipy.integrate.solve_ivp.
-METHODS = (*rosenbrock.TABLEAUX, "Radau", "BDF", "LSODA")
+#: Implicit methods: the numba-compiled Rosenbrock methods, and scipy.integrate.solve_ivp's Radau.
+METHODS = (*rosenbrock.TABLEAUX, "Radau")
 #: The method of the solver (docs/experiment-model-rate-state.md: the fewest steps, ~1000 times cheaper
 #: per step than Radau).
 DEFAULT_METHOD = "RODAS4"
 #: mm/s^2 per N/kg.
 MM_PER_M = 1000.0
-#: The compiled method that takes over for :data:`FALLBACK_SPAN` seconds, with the first session's
-#: absolute slip-rate tolerance (:data:`FALLBACK_V_SCALE`), where RODAS4's step size underflows
-#: (:meth:`SlabDynamics._integrate_compiled`).
-FALLBACK = "ROS2"
-#: [mm/s] per unit rtol: 1e-9 mm/s at rtol = 1e-4.
-FALLBACK_V_SCALE = 1e-5
-#: [s]
-FALLBACK_SPAN = 10.0
 #: The compiled integration runs in this many pieces of equal simulated time, with a progress
 #: report after each (the steps are the same as in one piece).
 PROGRESS_PIECES = 500
@@ -69,16 +64,13 @@ class Trajectory(NamedTuple):
     y : numpy.ndarray
         States there, [n_steps + 1, 3 m + 1].
     dydt : numpy.ndarray
-        Their time derivatives, [n_steps + 1, 3 m + 1] (for Hermite interpolation).
-    fallback_spans : numpy.ndarray
-        Start and end [s] of every span that :data:`FALLBACK` integrated because the method's step
-        size underflowed, float64 [k, 2] (k = 0: none; always none for the scipy methods).
+        Their time derivatives, [n_steps + 1, 3 m + 1] (for Hermite interpolation; the first m
+        columns are the slip rates).
     """
 
     t: np.ndarray
     y: np.ndarray
     dydt: np.ndarray
-    fallback_spans: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,19 +156,34 @@ class SlabDynamics:
         return (self._drive, self._stiffness, self._coupling, self._mu0, self._a, self._b, self._D_c,
                 float(self.law.V0), self._path)
 
-    def friction(self, V, psi, R=None):
-        """Friction coefficients of the slippable interfaces at slip rates ``V`` [mm/s], states ``psi``
-        and slips ``R`` [mm] (None: at the start of the slip path), [..., m] (the shape of ``V``)."""
+    def slip_rates(self, mu, psi, R=None):
+        """Slip rates [mm/s] of the slippable interfaces at friction coefficients ``mu``, states ``psi``
+        and slips ``R`` [mm] (None: at the start of the slip path), [..., m] (the shape of ``mu``)."""
         R = self._origin if R is None else R
-        R, V, psi = np.broadcast_arrays(np.asarray(R, dtype=float), np.asarray(V, dtype=float),
-                                        np.asarray(psi, dtype=float))
+        R, mu, psi = np.broadcast_arrays(np.asarray(R, dtype=float), np.asarray(mu, dtype=float),
+                                         np.asarray(psi, dtype=float))
         m = self._a.size
-        rows = [np.ascontiguousarray(x.reshape(-1, m)) for x in (R, V, psi)]
-        mu = _friction(*rows, self._mu0, self._a, self._b, float(self.law.V0), self._path)
-        return mu.reshape(V.shape)
+        rows = [np.ascontiguousarray(x.reshape(-1, m)) for x in (R, mu, psi)]
+        V = _slip_rates(*rows, self._mu0, self._a, self._b, float(self.law.V0), self._path)
+        return V.reshape(mu.shape)
+
+    def friction(self, V, psi):
+        """Friction coefficients ``mu = a asinh(V / w)`` of the slippable interfaces at slip rates ``V``
+        [mm/s] and states ``psi`` at the start of the slip path, [..., m] (the inverse of
+        :meth:`slip_rates` there)."""
+        width = 2.0 * self.law.V0 * np.exp(-(self._mu0 + self._b * np.asarray(psi, dtype=float)) / self._a)
+        return self._a * np.arcsinh(np.asarray(V, dtype=float) / width)
+
+    def accelerations(self, y):
+        """Newton's law: the rate of change of the slip rates, ``dV/dt = drive gamma - stiffness R -
+        coupling mu`` [mm/s^2], of states ``y`` [..., 3 m + 1], [..., m]."""
+        y = np.asarray(y, dtype=float)
+        m = self._a.size
+        return (y[..., 3 * m:] * self._drive - y[..., :m] @ self._stiffness.T
+                - y[..., m:2 * m] @ self._coupling.T)
 
     def rhs(self, y, rate):
-        """dy/dt of the state ``y = [R, V, psi, gamma]`` [3 m + 1] with the lever turning at ``rate`` [1/s]."""
+        """dy/dt of the state ``y = [R, mu, psi, gamma]`` [3 m + 1] with the lever turning at ``rate`` [1/s]."""
         return _rhs(y, rate, *self._arrays())
 
     def jacobian(self, y, rate):
@@ -193,31 +200,40 @@ class SlabDynamics:
         R0 : numpy.ndarray
             Slip of every interface [mm], [n_slabs] (at ``gamma_start``).
         y0 : numpy.ndarray
-            State vector ``[R_S, V_S, psi_S, gamma]``, [3 m + 1].
+            State vector ``[R_S, mu_S, psi_S, gamma]``, [3 m + 1].
         """
         V = np.broadcast_to(np.asarray(V_start, dtype=float), self._a.shape)
         psi = np.broadcast_to(np.log(self.law.V0 * np.asarray(theta_start, dtype=float) / self._D_c), self._a.shape)
+        mu = self.friction(V, psi)
         target = np.zeros(self.apparatus.n_slabs)
-        target[self.interfaces] = self.friction(V, psi)
+        target[self.interfaces] = mu
         shifted = dataclasses.replace(self.apparatus, gamma_start=gamma_start)
         R0 = shifted.relaxed_slips(target)
-        return R0, np.concatenate([R0[self.interfaces], V, psi, [gamma_start]])
+        return R0, np.concatenate([R0[self.interfaces], mu, psi, [gamma_start]])
 
-    def tolerances(self, rtol, R=1e-2, V=1e-11, psi=1.0):
-        """Absolute tolerances of the state components, proportional to the relative tolerance ``rtol``
-        (so that ``rtol`` alone sets how tight an integration is): ``rtol`` times the scales of the slips
-        ``R`` [mm], slip rates ``V`` [mm/s], states ``psi`` (and 1e-8 rad for gamma), float64 [3 m + 1].
-        At ``rtol`` = 1e-4: 1e-6 mm, 1e-15 mm/s, 1e-4 and 1e-12 rad.
+    def tolerances(self, rtol, R=1e-2, psi=1.0):
+        """Relative and absolute tolerances of the state components, both proportional to ``rtol``
+        (so that ``rtol`` alone sets how tight an integration is).
 
-        The slip rates are held to their relative error down to 1e-11 mm/s because the friction
-        depends on their logarithm (``d mu = a dV / V``): a stuck interface creeps at 1e-11 to 1e-9
-        mm/s, and an absolute 1e-9 mm/s (the tolerance before issue 12's third session) let a step
-        carry it through zero, flipping its friction (step-size underflow of RODAS4 at t = 334 s in
-        the stack n = 3, seed 1)."""
+        The slips ``R``, states ``psi`` and the rotation have the relative tolerance ``rtol`` and the
+        absolute ones ``rtol`` times the scales ``R`` [mm], ``psi`` (and 1e-8 rad); at ``rtol`` = 1e-4:
+        1e-6 mm, 1e-4, 1e-12 rad. The friction ``mu`` of interface ``k`` has no relative tolerance and
+        the absolute one ``a_k rtol``: since ``d mu = a dV / V`` on the rate-and-state branch, that is
+        the relative tolerance ``rtol`` on its slip rate, from creep at 1e-17 mm/s to slips at mm/s
+        (the slip rate's tolerance of the earlier formulation, which integrated ``V``), and it holds
+        through ``V = 0``.
+
+        Returns
+        -------
+        rtol, atol : numpy.ndarray
+            Float64 [3 m + 1] each.
+        """
         m = self.interfaces.size
-        return rtol * np.concatenate([np.full(m, R), np.full(m, V), np.full(m, psi), [1e-8]])
+        relative = np.concatenate([np.full(m, rtol), np.zeros(m), np.full(m + 1, rtol)])
+        absolute = rtol * np.concatenate([np.full(m, R), self._a, np.full(m, psi), [1e-8]])
+        return relative, absolute
 
-    def integrate(self, y0, duration, rate, *, method=DEFAULT_METHOD, rtol=1e-4, atol=None):
+    def integrate(self, y0, duration, rate, *, method=DEFAULT_METHOD, rtol=1e-4):
         """Integrate ``duration`` [s] from ``y0`` with the lever turning at ``rate`` [1/s].
 
         Parameters
@@ -228,13 +244,13 @@ class SlabDynamics:
             [s] (> 0).
         rate : float
             d gamma / dt [1/s] (0: a hold).
-        method : {"RODAS4", "ROS2", "Radau", "BDF", "LSODA"}
-            "RODAS4": the numba-compiled L-stable Rosenbrock method :func:`rosenbrock.integrate`; the
-            others: ``scipy.integrate.solve_ivp`` (:data:`METHODS`).
+        method : {"RODAS4", "ROS2", "Radau"}
+            "RODAS4" (and "ROS2"): the numba-compiled L-stable Rosenbrock methods of
+            :func:`rosenbrock.integrate`; the others: ``scipy.integrate.solve_ivp`` (:data:`METHODS`).
         rtol : float
-            Relative tolerance of the step control.
-        atol : numpy.ndarray, optional
-            Absolute tolerances [3 m + 1]; default :meth:`tolerances` of ``rtol``.
+            Relative tolerance of the step control; the tolerances of every component follow from it
+            (:meth:`tolerances`; scipy takes one relative tolerance for all, so there ``mu`` also has
+            ``rtol`` relative to its value).
 
         Notes
         -----
@@ -243,39 +259,30 @@ class SlabDynamics:
         log. The compiled methods integrate in :data:`PROGRESS_PIECES` pieces for that, with the same
         steps (and results, bit for bit) as in one piece.
 
-        Every span of :data:`FALLBACK` (:meth:`_integrate_compiled`) is reported on stderr after the
-        integration, as a line ``virtual experiment: RODAS4's step size underflowed 1 time(s); ROS2
-        integrated 670.233-680.233 s``.
-
         Returns
         -------
         Trajectory
-            Step times, states, their derivatives and the fallback spans.
+            Step times, states and their derivatives.
 
         Raises
         ------
         RuntimeError
-            If the integrator fails.
+            If the integrator fails (the step size underflows; no run of the shipped studies does).
         """
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
         y0 = np.ascontiguousarray(y0, dtype=float)
-        atol = self.tolerances(rtol) if atol is None else np.ascontiguousarray(atol, dtype=float)
+        relative, absolute = self.tolerances(rtol)
         duration = float(duration)
         with _SimulatedTime(duration) as clock:
             if method in rosenbrock.TABLEAUX:
-                trajectory = self._integrate_compiled(method, y0, duration, float(rate), rtol, atol, clock)
-            else:
-                trajectory = self._integrate_scipy(method, y0, duration, rate, rtol, atol, clock)
-        spans = trajectory.fallback_spans
-        if spans.size:
-            print(f"virtual experiment: {method}'s step size underflowed {len(spans)} time(s); {FALLBACK} integrated "
-                  + ", ".join(f"{start:.3f}-{end:.3f} s" for start, end in spans), file=sys.stderr)
-        return trajectory
+                return self._integrate_compiled(method, y0, duration, float(rate), relative, absolute, clock)
+            return self._integrate_scipy(method, y0, duration, rate, rtol, absolute, clock)
 
     def _integrate_scipy(self, method, y0, duration, rate, rtol, atol, clock):
         """``scipy.integrate.solve_ivp`` with ``method`` over ``duration`` [s]: a :class:`Trajectory`
-        (without fallback spans)."""
+        (scipy.integrate is imported here, not with the module: the default jobs never need it)."""
+        from scipy.integrate import solve_ivp
 
         def rhs(t, y):
             clock.at(t, None)
@@ -287,53 +294,28 @@ class SlabDynamics:
             raise RuntimeError(f"rate-and-state integration failed at t = {solution.t[-1]:.6g} s: {solution.message}")
         clock.at(duration, solution.t.size - 1)
         y = solution.y.T
-        return Trajectory(solution.t, y, np.array([self.rhs(row, rate) for row in y]), np.empty((0, 2)))
+        return Trajectory(solution.t, y, np.array([self.rhs(row, rate) for row in y]))
 
     def _integrate_compiled(self, name, y0, duration, rate, rtol, atol, clock):
         """:func:`rosenbrock.integrate` with the method ``name`` in :data:`PROGRESS_PIECES` pieces of
-        simulated time (the same steps as in one piece), reporting to ``clock`` after each.
-
-        Where its step size underflows, :data:`FALLBACK` (ROS2, with an absolute slip-rate tolerance
-        of 1e-9 mm/s at rtol = 1e-4, the first session's integrator, which ran the 10-seed study)
-        integrates the next :data:`FALLBACK_SPAN` seconds and the method starts again after them. This
-        happens deep in a stick: at slip rates of 1e-17 to 1e-13 mm/s an interface's equation of motion
-        is stiff at ~1e17 /s and its slip rate is slaved to the force balance through
-        ``mu = a asinh(V / w)``; RODAS4's linearly implicit stages project onto that slow manifold with a
-        relative error in ``V`` of ~20 % whatever the step, which its error control (relative in ``V``)
-        rejects (stack n = 5, seed 5, t = 670 s; test
-        ``test_the_fallback_deep_in_a_stick_keeps_the_slips_of_a_tight_reference``). The switch points
-        follow from the steps alone, so the pieces do not change them. Returns a :class:`Trajectory`."""
+        simulated time (the same steps as in one piece), reporting to ``clock`` after each; ``rtol``
+        and ``atol`` per component. Returns a :class:`Trajectory`."""
         args = (rate, *self._arrays())
-        method, fallback = rosenbrock.TABLEAUX[name].arrays(), rosenbrock.TABLEAUX[FALLBACK].arrays()
-        fallback_atol = self.tolerances(rtol, V=FALLBACK_V_SCALE)
-        t_now, y_now, h, steps = 0.0, y0, (rosenbrock.FIRST_STEP, 0.0, 1.0), 0
+        method = rosenbrock.TABLEAUX[name].arrays()
+        t_now, y_now, h, steps = 0.0, y0, rosenbrock.START, 0
         ts, ys, fs = [np.array([0.0])], [y0[None, :]], [self.rhs(y0, rate)[None, :]]
-        spans = []
         for k in range(1, PROGRESS_PIECES + 1):
             t_pause = duration * k / PROGRESS_PIECES
-            while t_now < t_pause:
-                t, y, dydt, ok, h = rosenbrock.integrate(y_now, t_now, h, t_pause, duration, args, rtol, atol,
-                                                         method)
-                if not ok:
-                    ts.append(t[1:])
-                    ys.append(y[1:])
-                    fs.append(dydt[1:])
-                    t_now, y_now, steps = t[-1], y[-1], steps + t.size - 1
-                    span_end = min(t_now + FALLBACK_SPAN, duration)
-                    t, y, dydt, ok, _ = rosenbrock.integrate(y_now, t_now, (rosenbrock.FIRST_STEP, 0.0, 1.0),
-                                                             span_end, span_end, args, rtol, fallback_atol, fallback)
-                    if not ok:
-                        raise RuntimeError(f"rate-and-state integration failed at t = {t[-1]:.6g} s: step size "
-                                           f"underflow of {name} and of {FALLBACK}")
-                    spans.append((t_now, t[-1]))
-                    h = (rosenbrock.FIRST_STEP, 0.0, 1.0)
-                ts.append(t[1:])            # every call starts where the previous one ended
-                ys.append(y[1:])
-                fs.append(dydt[1:])
-                t_now, y_now, steps = t[-1], y[-1], steps + t.size - 1
-                clock.at(t_now, steps)
-        return Trajectory(np.concatenate(ts), np.concatenate(ys), np.concatenate(fs),
-                          np.array(spans, dtype=float).reshape(-1, 2))
+            t, y, dydt, ok, h = rosenbrock.integrate(y_now, t_now, h, t_pause, duration, args, rtol, atol, method)
+            if not ok:
+                raise RuntimeError(f"rate-and-state integration failed at t = {t[-1]:.6g} s: step size underflow "
+                                   f"of {name}")
+            ts.append(t[1:])            # every call starts where the previous one ended
+            ys.append(y[1:])
+            fs.append(dydt[1:])
+            t_now, y_now, steps = t[-1], y[-1], steps + t.size - 1
+            clock.at(t_now, steps)
+        return Trajectory(np.concatenate(ts), np.concatenate(ys), np.concatenate(fs))
 
 
 class _SimulatedTime:

@@ -1,23 +1,34 @@
 """Right-hand side and Jacobian of the slab equations (:mod:`.slab_dynamics`), compiled.
 
-State ``y = [R, V, psi, gamma]`` (3 m + 1 values for m slippable interfaces): slips [mm], slip
-rates [mm/s], ``psi = ln(V0 theta/D_c)``, lever rotation [rad]::
+State ``y = [R, mu, psi, gamma]`` (3 m + 1 values for m slippable interfaces): slips [mm], friction
+coefficients, ``psi = ln(V0 theta/D_c)``, lever rotation [rad]. The friction is the regularised
+Dieterich–Ruina law (Rice & Ben-Zion 1996), odd in the slip rate ``V`` so that an interface may also
+slide backwards, written for the slip rate at a given friction::
+
+    V = w sinh(mu / a),        w = 2 V0 exp(-(mu0 + b psi) / a)
+
+(``mu = mu0 + a ln(V/V0) + b psi`` to within ``exp(-2 (mu0 + b psi)/a)`` < 1e-20 for ``V > 0``).
+Newton's law for the bodies, ``dV/dt = acc = drive gamma - stiffness R - coupling mu`` (the spring and
+friction forces on the bodies turned into relative accelerations of the interfaces [mm/s^2], ``A = D
+M^-1`` times the force matrices, see :class:`.slab_dynamics.SlabDynamics`), becomes an equation for
+``mu`` through ``dV/dt = dV/dmu dmu/dt + dV/dpsi dpsi/dt + dV/dR dR/dt``::
 
     dR/dt = V
-    dV/dt = drive gamma - stiffness R - coupling mu
+    dmu/dt = (a acc + V (b dpsi/dt + mu0'(R) V)) / W          W = w cosh(mu / a) = a dV/dmu
     dpsi/dt = (V0 exp(-psi) - |V|) / D_c
     dgamma/dt = rate
 
-``drive``, ``stiffness`` and ``coupling`` are the spring and friction forces on the bodies turned
-into relative accelerations of the interfaces [mm/s^2] (``A = D M^-1`` times the force matrices, see
-:class:`.slab_dynamics.SlabDynamics`). The friction is the regularised Dieterich–Ruina law (Rice &
-Ben-Zion 1996), odd in ``V`` so that an interface may also slide backwards::
+Why the friction and not the slip rate is the state: deep in a stick (``V`` ~ 1e-17 to 1e-13 mm/s)
+the interface's equation of motion is stiff at ~1e17 /s and its slip rate is slaved to the force
+balance ``acc = 0``. That balance is linear in ``mu`` (and in ``R``, ``gamma``), so the linearly
+implicit stages of a Rosenbrock method land on it exactly; in ``V`` it is logarithmic
+(``mu = a asinh(V/w)``), and the stages missed it by ~20 % of ``V`` whatever the step (the RODAS4
+-> ROS2 fallback of issue 12). A slip rate through zero is ``mu`` through zero, where ``V`` is linear
+in ``mu``; the arrest of a slip is a finite change of ``mu``, not ~30 e-folds of ``V``.
 
-    mu = a asinh(V / (2 V0) exp((mu0 + b psi) / a))
-
-which equals ``mu0 + a ln(V/V0) + b psi`` to within ``exp(-2 (mu0 + b psi)/a)`` (< 1e-20 here)
-for ``V > 0``. ``mu0`` may vary along the slip path, ``mu0_k(R_k)`` (:mod:`.slip_path`), so that the
-friction also depends on the slip ``R``.
+``mu0`` may vary along the slip path, ``mu0_k(R_k)`` (:mod:`.slip_path`), so that the slip rate
+also depends on the slip ``R``. ``V`` and ``W`` are computed from ``exp((±|mu| - mu0 - b psi)/a)``,
+which neither overflows nor underflows at the values a run reaches.
 
 The arguments after ``y`` are the same for every function here (``rate, drive, stiffness, coupling,
 mu0, a, b, D_c, V0, path``, see :func:`rhs`), so that the integrator passes one tuple to all of them.
@@ -30,52 +41,47 @@ import numpy as np
 from ...numba_options import njit
 from .slip_path import level
 
-__all__ = ["rhs", "rhs_into", "jacobian", "friction", "friction_slopes"]
+__all__ = ["rhs", "rhs_into", "jacobian", "jacobian_into", "slip_rate", "slip_rates"]
 
 
 @njit
-def _friction(V, psi, mu0, a, b, V0):
-    """Friction coefficient of one interface (scalars)."""
-    return a * math.asinh(V / (2.0 * V0) * math.exp((mu0 + b * psi) / a))
+def slip_rate(mu, psi, mu0, a, b, V0):
+    """Slip rate ``V`` [mm/s] of one interface at friction ``mu``, state ``psi`` and level ``mu0``
+    (scalars), and ``W = w cosh(mu / a) = a dV/dmu`` [mm/s] (> 0)."""
+    level_psi = mu0 + b * psi
+    up = math.exp((abs(mu) - level_psi) / a)
+    down = math.exp((-abs(mu) - level_psi) / a)
+    V = V0 * (up - down)
+    return (V if mu >= 0.0 else -V), V0 * (up + down)
 
 
 @njit
-def friction_slopes(V, psi, mu0, a, b, V0):
-    """``d mu / dV`` [s/mm], ``d mu / d psi`` and ``d mu / d mu0`` of one interface (scalars)."""
-    width = 2.0 * V0 * math.exp(-(mu0 + b * psi) / a)    # mu = a asinh(V / width)
-    root = math.sqrt(width * width + V * V)
-    return a / root, b * V / root, V / root
-
-
-@njit
-def friction(R, V, psi, mu0, a, b, V0, path):
-    """Regularised friction coefficients at slips ``R`` [mm], slip rates ``V`` [mm/s] and states
-    ``psi``, all float64 [k, m] (one row per time, one column per interface), with the parameters
-    ``mu0, a, b`` [m], ``V0`` and the slip ``path`` (:func:`.slip_path.slip_path`); returns [k, m]."""
-    mu = np.empty(V.shape)
-    for row in range(V.shape[0]):
-        for k in range(V.shape[1]):
-            level_k, _ = level(k, R[row, k], mu0, path)
-            mu[row, k] = _friction(V[row, k], psi[row, k], level_k, a[k], b[k], V0)
-    return mu
+def slip_rates(R, mu, psi, mu0, a, b, V0, path):
+    """Slip rates [mm/s] at slips ``R`` [mm], friction coefficients ``mu`` and states ``psi``, all
+    float64 [k, m] (one row per time, one column per interface), with the parameters ``mu0, a, b``
+    [m], ``V0`` and the slip ``path`` (:func:`.slip_path.slip_path`); returns [k, m]."""
+    V = np.empty(mu.shape)
+    for row in range(mu.shape[0]):
+        for k in range(mu.shape[1]):
+            level_k, _, _ = level(k, R[row, k], mu0, path)
+            V[row, k], _ = slip_rate(mu[row, k], psi[row, k], level_k, a[k], b[k], V0)
+    return V
 
 
 @njit
 def rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
     """dy/dt written into ``out`` (float64 [3 m + 1]; no allocation); arguments of :func:`rhs`."""
     m = mu0.size
-    for k in range(m):                     # out[2m:3m] holds mu until the last loop
-        level_k, _ = level(k, y[k], mu0, path)
-        out[2 * m + k] = _friction(y[m + k], y[2 * m + k], level_k, a[k], b[k], V0)
     gamma = y[3 * m]
-    for i in range(m):
-        acceleration = drive[i] * gamma
-        for k in range(m):
-            acceleration -= stiffness[i, k] * y[k] + coupling[i, k] * out[2 * m + k]
-        out[m + i] = acceleration
-    for i in range(m):
-        out[i] = y[m + i]
-        out[2 * m + i] = (V0 * math.exp(-y[2 * m + i]) - abs(y[m + i])) / D_c[i]
+    for k in range(m):                     # out[:m] holds V, out[2m:3m] dpsi/dt
+        level_k, level_slope, _ = level(k, y[k], mu0, path)
+        V, W = slip_rate(y[m + k], y[2 * m + k], level_k, a[k], b[k], V0)
+        out[k] = V
+        out[2 * m + k] = (V0 * math.exp(-y[2 * m + k]) - abs(V)) / D_c[k]
+        acceleration = drive[k] * gamma
+        for j in range(m):
+            acceleration -= stiffness[k, j] * y[j] + coupling[k, j] * y[m + j]
+        out[m + k] = (a[k] * acceleration + V * (b[k] * out[2 * m + k] + level_slope * V)) / W
     out[3 * m] = rate
 
 
@@ -86,7 +92,7 @@ def rhs(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
     Parameters
     ----------
     y : numpy.ndarray
-        State [3 m + 1].
+        State ``[R, mu, psi, gamma]`` [3 m + 1].
     rate : float
         d gamma/dt [1/s].
     drive : numpy.ndarray
@@ -110,19 +116,56 @@ def rhs(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
 
 
 @njit
+def jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+    """d(dy/dt)/dy written into ``J`` (float64 [3 m + 1, 3 m + 1], overwritten); arguments of :func:`rhs`.
+
+    With ``s = a / W``, ``tau = V / W = tanh(mu / a)``, ``lam = mu0'(R)``, ``Q = b dpsi/dt + lam V``,
+    ``dmu/dt = s acc + tau Q``: ``dV/dmu = W/a``, ``dV/dpsi = -b V/a``, ``dV/dR = -lam V/a``,
+    ``ds/dmu = -tau/W``, ``ds/dpsi = b s/a``, ``ds/dR = lam s/a``, ``dtau/dmu = (1 - tau^2)/a``.
+    """
+    m = mu0.size
+    gamma = y[3 * m]
+    J[:, :] = 0.0
+    for k in range(m):
+        level_k, lam, curvature = level(k, y[k], mu0, path)
+        mu, psi = y[m + k], y[2 * m + k]
+        V, W = slip_rate(mu, psi, level_k, a[k], b[k], V0)
+        ak, bk, Dk = a[k], b[k], D_c[k]
+        s = ak / W
+        tau = V / W
+        sech2 = (2.0 * V0 * math.exp(-(level_k + bk * psi) / ak) / W) ** 2      # 1 - tau^2
+        sign = 1.0 if V > 0.0 else (-1.0 if V < 0.0 else 0.0)
+        aging = V0 * math.exp(-psi)
+        psi_rate = (aging - abs(V)) / Dk
+        psi_by_mu = -sign * W / (ak * Dk)
+        psi_by_psi = (-aging + bk / ak * abs(V)) / Dk
+        psi_by_R = lam / ak * abs(V) / Dk
+        Q = bk * psi_rate + lam * V
+        acceleration = drive[k] * gamma
+        for j in range(m):
+            acceleration -= stiffness[k, j] * y[j] + coupling[k, j] * y[m + j]
+        # dR/dt = V
+        J[k, k] = -lam / ak * V
+        J[k, m + k] = W / ak
+        J[k, 2 * m + k] = -bk / ak * V
+        # dmu/dt = s acc + tau Q
+        for j in range(m):
+            J[m + k, j] = -s * stiffness[k, j]
+            J[m + k, m + j] = -s * coupling[k, j]
+        J[m + k, k] += lam / ak * s * acceleration + tau * (bk * psi_by_R + (curvature - lam * lam / ak) * V)
+        J[m + k, m + k] += (-tau / W * acceleration + sech2 / ak * Q
+                            + tau * (bk * psi_by_mu + lam * W / ak))
+        J[m + k, 2 * m + k] = bk / ak * s * acceleration + tau * (bk * psi_by_psi - lam * bk / ak * V)
+        J[m + k, 3 * m] = s * drive[k]
+        # dpsi/dt
+        J[2 * m + k, k] = psi_by_R
+        J[2 * m + k, m + k] = psi_by_mu
+        J[2 * m + k, 2 * m + k] = psi_by_psi
+
+
+@njit
 def jacobian(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
     """d(dy/dt)/dy, float64 [3 m + 1, 3 m + 1]; arguments of :func:`rhs`."""
-    m = mu0.size
-    J = np.zeros((3 * m + 1, 3 * m + 1))
-    for k in range(m):
-        level_k, level_slope = level(k, y[k], mu0, path)
-        by_V, by_psi, by_level = friction_slopes(y[m + k], y[2 * m + k], level_k, a[k], b[k], V0)
-        for i in range(m):
-            J[m + i, k] = -stiffness[i, k] - coupling[i, k] * by_level * level_slope
-            J[m + i, m + k] = -coupling[i, k] * by_V
-            J[m + i, 2 * m + k] = -coupling[i, k] * by_psi
-        J[k, m + k] = 1.0
-        J[m + k, 3 * m] = drive[k]
-        J[2 * m + k, m + k] = -np.sign(y[m + k]) / D_c[k]
-        J[2 * m + k, 2 * m + k] = -V0 / D_c[k] * math.exp(-y[2 * m + k])
+    J = np.empty((y.size, y.size))
+    jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
     return J

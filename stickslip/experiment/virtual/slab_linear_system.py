@@ -1,42 +1,33 @@
-"""The linear systems ``(I - c J) u = r`` of an implicit step on the slab equations, solved by their block structure.
+"""The linear systems ``(I - c J) u = r`` of an implicit step on the slab equations.
 
-``J`` is the Jacobian of :mod:`.slab_equations` (state ``[R, V, psi, gamma]``, 3 m + 1 values)::
+``J`` is the Jacobian of :mod:`.slab_equations` (state ``[R, mu, psi, gamma]``, 3 m + 1 <= 16 values).
+Its rows of ``dmu/dt`` carry ``a / W`` times the springs and the friction coupling, with ``W`` ~ the
+slip rate: ~1e19 /s deep in a stick against ~1 in the other rows. So the matrix is equilibrated
+(each row divided by its largest entry, the right-hand side with it) before an LU factorisation with
+partial pivoting; without that, the pivots come from the huge rows and the rounding errors they carry
+(~1e-16 of 1e19) swamp the other rows.
 
-    J = | 0    I             0              0     |       s_k = -sign(V_k) / D_c,k
-        | -P'  -C diag(mu_V)  -C diag(mu_psi)  q  |       d_k = -V0 exp(-psi_k) / D_c,k
-        | 0    diag(s)       diag(d)        0     |       mu_V, mu_psi, mu_R: slopes of the friction
-        | 0    0             0              0     |
-
-(``P' = P + C diag(mu_R)``, ``P`` = stiffness, ``C`` = coupling, ``q`` = drive; ``mu_R`` is the slope
-along the slip path, :mod:`.slip_path`, 0 without heterogeneity). Eliminating the slips, the states and the
-rotation leaves an m x m system for the slip rates (the Schur complement)::
-
-    u_gamma = r_gamma
-    [I + c^2 P' + c C diag(mu_V + c mu_psi s / (1 - c d))] u_V
-        = r_V - c P' r_R - c C diag(mu_psi / (1 - c d)) r_psi + c q r_gamma
-    u_R = r_R + c u_V
-    u_psi = (r_psi + c s u_V) / (1 - c d)
-
-which is exact algebra (``1 - c d >= 1``). The m x m matrix is factorised once per step (LU with
-partial pivoting, m <= n_slabs) and the factors serve every stage of the Rosenbrock step: a
-factorisation costs ~m^3/3 and a solve ~m^2 operations, against ~(3 m + 1)^3/3 and a copy for a
-dense LAPACK solve of the whole system (:mod:`.rosenbrock`; measured in docs/benchmarks.md).
+Why dense and not by blocks: eliminating a slip and a state per interface first (the rows of ``R``
+and ``psi`` are diagonal) divides by ``1 - c dpsi'/dpsi``, which passes through zero while a slip
+accelerates (``dpsi'/dpsi = (b |V| / a - V0 exp(-psi)) / D_c > 0`` at fixed ``mu``); pivoting over
+the whole matrix has no such point. At m <= 5 the factorisation costs ~(3 m + 1)^3 / 3 ~ 1400
+multiply-adds per step and each of the stages' solves ~(3 m + 1)^2 (measured in
+docs/experiment-model-rate-state.md).
 """
 
 import numpy as np
 
 from ...numba_options import njit
-from .slab_equations import friction_slopes
-from .slip_path import level
+from .slab_equations import jacobian_into
 
 __all__ = ["new_factors", "factorize", "solve"]
 
 
 @njit
-def new_factors(m):
-    """Work arrays of the factorisation for ``m`` interfaces: ``lu`` float64 [m, m], ``pivot`` int64
-    [m], ``diagonals`` float64 [4, m] (``mu_psi / (1 - c d)``, ``s``, ``1 / (1 - c d)``, ``mu_R``)."""
-    return np.empty((m, m)), np.zeros(m, dtype=np.int64), np.empty((4, m))
+def new_factors(n):
+    """Work arrays of the factorisation of an ``n`` x ``n`` system: ``lu`` float64 [n, n], ``pivot``
+    int64 [n], ``scale`` float64 [n] (the rows' equilibration factors)."""
+    return np.empty((n, n)), np.zeros(n, dtype=np.int64), np.empty(n)
 
 
 @njit
@@ -54,62 +45,56 @@ def factorize(y, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V
     rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path
         Arguments of :func:`.slab_equations.rhs`.
     """
-    lu, pivot, diagonals = factors
-    m = mu0.size
-    for k in range(m):
-        level_k, level_slope = level(k, y[k], mu0, path)
-        by_V, by_psi, by_level = friction_slopes(y[m + k], y[2 * m + k], level_k, a[k], b[k], V0)
-        by_R = by_level * level_slope
-        s = -np.sign(y[m + k]) / D_c[k]
-        inverse = 1.0 / (1.0 + c * V0 / D_c[k] * np.exp(-y[2 * m + k]))   # 1 / (1 - c d)
-        diagonals[0, k] = by_psi * inverse
-        diagonals[1, k] = s
-        diagonals[2, k] = inverse
-        diagonals[3, k] = by_R
-        weight = by_V + c * by_psi * s * inverse
-        for i in range(m):
-            lu[i, k] = c * c * (stiffness[i, k] + coupling[i, k] * by_R) + c * coupling[i, k] * weight
-        lu[k, k] += 1.0
-    for j in range(m):                     # LU with partial pivoting, in place
+    lu, pivot, scale = factors
+    n = y.size
+    jacobian_into(y, lu, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
+    for i in range(n):
+        largest = 0.0
+        for k in range(n):
+            lu[i, k] *= -c
+            if k == i:
+                lu[i, k] += 1.0
+            largest = max(largest, abs(lu[i, k]))
+        scale[i] = 1.0 / largest
+        for k in range(n):
+            lu[i, k] *= scale[i]
+    for j in range(n):                     # LU with partial pivoting, in place
         best = j
-        for i in range(j + 1, m):
+        for i in range(j + 1, n):
             if abs(lu[i, j]) > abs(lu[best, j]):
                 best = i
         pivot[j] = best
         if best != j:
-            for k in range(m):
+            for k in range(n):
                 lu[j, k], lu[best, k] = lu[best, k], lu[j, k]
-        for i in range(j + 1, m):
-            lu[i, j] /= lu[j, j]
-            for k in range(j + 1, m):
-                lu[i, k] -= lu[i, j] * lu[j, k]
+        if lu[j, j] == 0.0:
+            continue                       # singular: solve returns inf/nan, and the step is rejected
+        for i in range(j + 1, n):
+            factor = lu[i, j] / lu[j, j]
+            lu[i, j] = factor
+            if factor != 0.0:
+                for k in range(j + 1, n):
+                    lu[i, k] -= factor * lu[j, k]
 
 
 @njit
 def solve(r, u, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
     """Solve ``(I - c J) u = r`` with the factors of :func:`factorize` (same ``c``); ``r`` and ``u``
     float64 [3 m + 1] (distinct arrays); returns None."""
-    lu, pivot, diagonals = factors
-    m = mu0.size
-    for i in range(m):                     # the reduced right-hand side, into u_V
-        total = r[m + i] + c * drive[i] * r[3 * m]
-        for k in range(m):
-            total -= c * ((stiffness[i, k] + coupling[i, k] * diagonals[3, k]) * r[k]
-                          + coupling[i, k] * diagonals[0, k] * r[2 * m + k])
-        u[m + i] = total
-    for j in range(m):                     # the factorisation's row swaps, in order
+    lu, pivot, scale = factors
+    n = r.size
+    for i in range(n):
+        u[i] = r[i] * scale[i]
+    for j in range(n):                     # the factorisation's row swaps, in order
         best = pivot[j]
         if best != j:
-            u[m + j], u[m + best] = u[m + best], u[m + j]
-    for j in range(m):                     # forward substitution (unit lower triangle)
-        for i in range(j + 1, m):
-            u[m + i] -= lu[i, j] * u[m + j]
-    for i in range(m - 1, -1, -1):         # back substitution
-        total = u[m + i]
-        for k in range(i + 1, m):
-            total -= lu[i, k] * u[m + k]
-        u[m + i] = total / lu[i, i]
-    for k in range(m):
-        u[k] = r[k] + c * u[m + k]
-        u[2 * m + k] = (r[2 * m + k] + c * diagonals[1, k] * u[m + k]) * diagonals[2, k]
-    u[3 * m] = r[3 * m]
+            u[j], u[best] = u[best], u[j]
+    for j in range(n):                     # forward substitution (unit lower triangle)
+        if u[j] != 0.0:
+            for i in range(j + 1, n):
+                u[i] -= lu[i, j] * u[j]
+    for i in range(n - 1, -1, -1):         # back substitution
+        total = u[i]
+        for k in range(i + 1, n):
+            total -= lu[i, k] * u[k]
+        u[i] = total / lu[i, i]

@@ -18,7 +18,7 @@ exactly 1 over the period (mean exactly 0). Between the nodes, ``g`` and its slo
 Hermite interpolant of the exact nodal values and slopes (continuous value and slope; relative
 error ~ (q spacing)^4 / 384 < 1e-5 for the modes that carry the variance): constant cost per
 evaluation inside the compiled right-hand side and its analytic Jacobian, which needs
-``d mu0 / d delta``.
+``d mu0 / d delta`` and ``d^2 mu0 / d delta^2``.
 """
 
 import dataclasses
@@ -101,6 +101,12 @@ class PathProfiles:
         values, slopes, spacing = random_profiles(path_stream(seed), n_slabs, correlation_length)
         return cls(float(relative_amplitude), values, slopes, spacing)
 
+    def reordered(self, order):
+        """The profiles with row ``i`` taken from row ``order[i]`` (int [n_slabs]; a shuffled stack,
+        whose surfaces travel with their slabs)."""
+        order = np.asarray(order, dtype=int)
+        return dataclasses.replace(self, values=self.values[order], slopes=self.slopes[order])
+
     def arguments(self, interfaces, mu0, origin):
         """The ``path`` argument of the compiled code (:func:`slip_path`) for the 0-based ``interfaces``
         [m] with the steady friction ``mu0`` [m] at the start and the slips ``origin`` [m] [mm] where
@@ -133,12 +139,14 @@ def no_path(count):
 
 @njit
 def level(k, R, mu0, path):
-    """``mu0_k`` at the slip ``R`` [mm] of interface ``k`` and its derivative ``d mu0_k / dR`` [1/mm].
+    """``mu0_k`` at the slip ``R`` [mm] of interface ``k``, its slope ``d mu0_k / dR`` [1/mm] and its
+    curvature ``d^2 mu0_k / dR^2`` [1/mm^2] (of the cubic Hermite interpolant: continuous value and
+    slope, the curvature jumps at the nodes).
 
-    ``path`` is from :func:`slip_path`; with a zero amplitude the result is ``(mu0[k], 0.0)`` exactly."""
+    ``path`` is from :func:`slip_path`; with a zero amplitude the result is ``(mu0[k], 0.0, 0.0)`` exactly."""
     amplitude, origin, values, slopes, spacing = path
     if amplitude[k] == 0.0:
-        return mu0[k], 0.0
+        return mu0[k], 0.0, 0.0
     nodes = values.shape[1]
     x = (R - origin[k]) / spacing
     cell = math.floor(x)
@@ -150,4 +158,5 @@ def level(k, R, mu0, path):
     s2, s3 = s * s, s * s * s
     g = (2 * s3 - 3 * s2 + 1) * g0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * g1 + (s3 - s2) * d1
     dg = ((6 * s2 - 6 * s) * g0 + (3 * s2 - 4 * s + 1) * d0 + (-6 * s2 + 6 * s) * g1 + (3 * s2 - 2 * s) * d1) / spacing
-    return mu0[k] + amplitude[k] * g, amplitude[k] * dg
+    d2g = ((12 * s - 6) * g0 + (6 * s - 4) * d0 + (6 - 12 * s) * g1 + (6 * s - 2) * d1) / (spacing * spacing)
+    return mu0[k] + amplitude[k] * g, amplitude[k] * dg, amplitude[k] * d2g
