@@ -37,7 +37,7 @@ from . import extraction
 from .plugin import event_attrs
 
 __all__ = ["FrontParams", "VERSION", "slipping_interfaces", "front_fit", "analyse_event", "multi_slip_increments",
-           "interface_spacing", "front_tables", "write_front_file", "run"]
+           "interface_spacing", "front_tables", "write_front_file", "solver_replay", "run"]
 
 NAME = "front-dynamics"
 VERSION = "1"
@@ -279,10 +279,10 @@ def write_front_file(failures, fronts, attrs, output, *, input, params=FrontPara
                         attrs=attrs, tables={"failures": failures, "fronts": fronts})
 
 
-def _replay(input):
-    """The replay of the solver that wrote ``input`` (from its lineage)."""
+def solver_replay(input, analysis=NAME):
+    """The replay of the solver that wrote ``input`` (from its lineage), for the analysis ``analysis``."""
     if not isinstance(input, Artifact):
-        raise FileFormatError(f"{input}: front-dynamics needs the lineage of its input (a "
+        raise FileFormatError(f"{input}: {analysis} needs the lineage of its input (a "
                               "stickslip.lineage.Artifact naming the solver that wrote it)")
     solver = registry.get("solver", input.plugin)
     if solver.replay is None:
@@ -295,7 +295,7 @@ def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
     from ..fem.output import read_increments, read_run_attrs
 
-    replay = _replay(input)
+    replay = solver_replay(input)
     run_attrs = read_run_attrs(input)
     for key in ("N", "h", "c_s"):
         if key not in run_attrs:

@@ -48,7 +48,7 @@ FORMAT = "fem-run"
 _STATE = ("u", "target", "lever_target", "t")
 
 
-def create_file(file, header, mesh, linear_response, columns):
+def create_file(file, header, mesh, linear_response, columns, dtypes=None):
     """Write the header of a new ``fem-run`` file (no increment yet).
 
     Parameters
@@ -63,6 +63,8 @@ def create_file(file, header, mesh, linear_response, columns):
         ``(delta_u [ndof], delta_eps [ni, 4, 3], delta_target [nlayer], delta_lever)``.
     columns : Sequence[str]
         Columns of the observables table after ``increment``, ``kick``, ``yield_element``.
+    dtypes : Mapping[str, numpy.dtype], optional
+        Types of columns that are neither float64 nor the well counts ``S_*``, ``A_*`` (int64).
     """
     formats.stamp(file, FORMAT)
     write_attrs(file, {**header, "version": __version__, "nstored": 0, "completed": False, "stop_reason": ""})
@@ -81,7 +83,7 @@ def create_file(file, header, mesh, linear_response, columns):
         write_dataset(state, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
     table = file.create_group("increments")
     columns = ["increment", "kick", "yield_element"] + list(columns)
-    dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool}
+    dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool, **(dtypes or {})}
     for name in columns:
         dtype = dtypes.get(name, np.int64 if name[:2] in ("S_", "A_") else np.float64)
         write_dataset(table, name, np.zeros(0, dtype=dtype), maxshape=(None,), chunks=(1024,))
@@ -237,9 +239,13 @@ def describe(path):
     -------
     dict[str, object]
         ``n`` (interfaces), ``plates``, ``blocks`` (N), ``k_drive``, ``phi`` and ``regime``
-        (the file's own attributes, :mod:`.stiffness`), ``seed``.
+        (the file's own attributes, :mod:`.stiffness`), ``seed``, ``temperature`` (0: athermal), and
+        for a thermal run ``attempt_rate`` and ``drive_rate`` (None for an athermal one).
     """
     attrs = read_run_attrs(path)
+    thermal = attrs.get("protocol") == "thermal"
     return {"n": int(attrs["n_interfaces"]), "plates": int(attrs["plates"]), "blocks": int(attrs["N"]),
             "k_drive": float(attrs["k_drive"]), "phi": float(attrs["phi"]), "regime": str(attrs["regime"]),
-            "seed": int(attrs["seed"])}
+            "seed": int(attrs["seed"]), "temperature": float(attrs["temperature"]) if thermal else 0.0,
+            "attempt_rate": float(attrs["attempt_rate"]) if thermal else None,
+            "drive_rate": float(attrs["drive_rate"]) if thermal else None}

@@ -62,7 +62,7 @@ class Format:
     describe : str or None
         ``"module:function"``: ``function(path) -> dict`` of the database's simulation
         columns (``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
-        ``phi``, ``regime``, ``seed``) read from one file.
+        ``phi``, ``regime``, ``seed``, ``temperature``, ``attempt_rate``, ``drive_rate``) read from one file.
     """
 
     name: str
