@@ -10,21 +10,25 @@ experiment done on its stored states:
   was held), ``mu_before`` (the interface's stress before the slip, its peak [sig0]) and the aging
   rate of the slip ``B_a = dmu / ln(T / T0)`` with the microscopic time ``T0 = 1 / attempt_rate``;
   for an athermal run, whose ``t`` counts minimisation time steps, not time, these are NaN;
-- **slow slip** per interface over the steady state: ``R_a = ubar_(2a) - ubar_(2a-2)`` (the plates on
-  either side), ``R_tot`` its change, ``dR_sum`` the sum of its changes over the interface's slip
-  events (the paper's slip criterion, ``A_a == N``), ``R_slow = 1 - dR_sum / R_tot``
-  (:func:`stickslip.experiment.aging.slow_slip_fraction`);
-- **hold trials** (thermal runs): ``states`` steady-state slip increments, evenly spaced, each held
+- **slow slip** per interface over the steady state: the interface's plastic slip ``R_a`` counted in
+  well hops (the signed hops ``S_a`` of its blocks, Gauss point 0, summed over the increments; the
+  model's counterpart of the slabs' relative position: the relative displacement of the plates would
+  include their elastic shear, which returns every cycle and is no slip), ``R_tot`` its growth,
+  ``dR_sum`` the part made in the interface's slip events (the paper's numerical slip criterion,
+  ``A_a == N``), ``R_slow = 1 - dR_sum / R_tot`` (:func:`stickslip.experiment.aging.slow_slip_fraction`):
+  the slip made by microscopic events, thermally activated or not;
+- **hold trials** (thermal runs with ``hold_interfaces`` interfaces, any if 0): ``states`` steady-state
+  slip increments, evenly spaced, each held
   for every one of ``hold_times`` at a load ``below`` under its athermal threshold and reloaded
   (:mod:`stickslip.fem.thermal.holds`, through the solver's replay), paired: every hold time of a
   state draws from the same random stream.
 
 Output (format ``event-table``): ``slip_events`` (the normalised table; further columns ``T``,
-``hold``, ``B_a``, ``mu_before``, ``dgamma``), ``interfaces`` (``a``, ``R_tot``, ``dR_sum`` [length],
+``hold``, ``B_a``, ``mu_before``, ``dgamma``), ``interfaces`` (``a``, ``R_tot``, ``dR_sum`` [well hops],
 ``R_slow``, ``n_slips``), ``holds`` (one row per trial: ``trial``, ``state`` (increment), ``replica``,
 ``hold_time``, ``peak``, ``interface``, ``mu_start`` [sig0], ``failed_in_hold``, ``t_slip``,
 ``hold_hops``, ``events``), ``creep`` (``trial``, ``t`` since the hold's start, ``R_<a>`` the slip of
-interface a since then [length], after each hop within a hold), ``barriers`` (``trial``, ``block``,
+interface a since then [well hops], after each hop within a hold), ``barriers`` (``trial``, ``block``,
 ``start``, ``end``: every block's forward barrier at the start and end of the hold, in units of the
 temperature). Times are the run's (FE time units); root attributes as ``numerical-events`` plus
 ``T0`` and ``thermal``.
@@ -61,6 +65,7 @@ class ThermalEventParams:
                                           unit="1/attempt_rate", minimum=0.0)
     below: float = param(0.02, "hold trials: imposed shear between the held load and the athermal threshold",
                          unit="eps0", minimum=0.0)
+    hold_interfaces: int = param(1, "hold trials only in runs with this many interfaces (0: every run)", minimum=0)
 
 
 def _slip_rows(classified, N, a):
@@ -113,25 +118,24 @@ def slip_table(increments, classified, N, *, T0=None):
         "mu_before": before, "dgamma": per_interface["dgamma"]}))
 
 
-def interface_table(increments, classified, N):
-    """Slow slip of every interface over the steady state (module docstring): ``ubar_<layer>`` of ``increments``,
-    the steady state and slips of ``classified``.
+def interface_table(classified, N):
+    """Slow slip of every interface over the steady state (module docstring), from :func:`.extraction.classify_increments`.
 
     Returns
     -------
     pandas.DataFrame
-        ``a``, ``R_tot``, ``dR_sum`` [length], ``R_slow``, ``n_slips``; no rows without a steady state.
+        ``a``, ``R_tot``, ``dR_sum`` [well hops], ``R_slow``, ``n_slips``; no rows without a steady state.
     """
     steady = np.flatnonzero(classified["steady"].to_numpy(dtype=bool))
     rows = []
     for a in extraction.interfaces_in(classified):
-        R = increments[f"ubar_{2 * a}"].to_numpy(dtype=float) - increments[f"ubar_{2 * a - 2}"].to_numpy(dtype=float)
         if steady.size == 0:
             continue
+        hops = classified[f"S_a{a}"].to_numpy(dtype=float)
         slips = _slip_rows(classified, N, a)
         slips = slips[slips > steady[0]]
-        R_tot = R[steady[-1]] - R[steady[0]]
-        dR_sum = float(np.sum(R[slips] - R[slips - 1]))
+        R_tot = float(np.sum(hops[steady[0] + 1:]))
+        dR_sum = float(np.sum(hops[slips]))
         rows.append({"a": a, "R_tot": R_tot, "dR_sum": dR_sum, "R_slow": float(slow_slip_fraction(R_tot, dR_sum)),
                      "n_slips": slips.size})
     return pd.DataFrame(rows, columns=["a", "R_tot", "dR_sum", "R_slow", "n_slips"])
@@ -205,7 +209,7 @@ def run(params, input, output):
     slips = slip_table(increments, classified, N, T0=T0)
     steady_slips = np.unique(slips["increment"].to_numpy())
     states = []
-    if thermal and params.states and steady_slips.size:
+    if thermal and params.states and steady_slips.size and params.hold_interfaces in (0, n):
         pick = np.unique(np.linspace(0, steady_slips.size - 1, min(params.states, steady_slips.size)).round())
         states = steady_slips[pick.astype(np.int64)]
         replay = solver_replay(input, NAME)
@@ -215,5 +219,5 @@ def run(params, input, output):
     attrs = {**event_attrs(run_attrs, classified, source=str(input)), "thermal": thermal,
              "T0": T0 if thermal else np.nan}
     write_analysis_file(output, "event-table", analysis=NAME, version=VERSION, params=params, input=input,
-                        attrs=attrs, tables={"slip_events": slips, "interfaces": interface_table(increments, classified, N),
+                        attrs=attrs, tables={"slip_events": slips, "interfaces": interface_table(classified, N),
                                              "holds": holds, "creep": creep, "barriers": barriers})

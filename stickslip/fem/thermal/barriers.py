@@ -28,7 +28,7 @@ FORWARD = 0
 BACKWARD = 1
 
 
-@njit(inline="always")
+@njit
 def _point(law, eq, lo, hi, idx, direction):
     """Constant-load barrier density of one Gauss point [stress]."""
     if direction == FORWARD:

@@ -7,7 +7,8 @@ From a stored state the load is brought (an elastic step along the linear respon
 ``hold_time`` while the blocks hop (creep); then it is driven on at the run's drive rate until the
 next slip event (every block of some interface in another well), which may also come during the
 hold (delayed failure). The trial records the peak stress of the slipping interface (its stress at
-the load increment before the slip), the creep during the hold, and every block's forward barrier
+the load increment before the slip), the creep during the hold (the interface's slip in well hops),
+and every block's forward barrier
 at the start and at the end of the hold (the state at rest after the last hop within it).
 """
 
@@ -33,10 +34,9 @@ def _barriers(system, unit):
     return out[:, FORWARD] / unit
 
 
-def _slips(system, interfaces):
-    """Relative displacement ``R_a`` of the plates on either side of every interface [length]."""
-    ubar = system.state.ubar
-    return np.array([ubar[2 * a] - ubar[2 * a - 2] for a in interfaces])
+def _slips(observer):
+    """Plastic slip of every interface in well hops: the sum of its blocks' well indices (Gauss point 0)."""
+    return observer.well_index().sum(axis=1).astype(np.float64)
 
 
 def hold_trial(system, state, hold_time, below, replica):
@@ -61,8 +61,9 @@ def hold_trial(system, state, hold_time, below, replica):
         ``t0`` (time at the hold's start), ``peak`` [sig0] and ``interface`` (lowest slipping one; NaN and
         0 if no slip came within :data:`MAX_EVENTS` events), ``mu_start`` [sig0] (its stress at the hold's
         start), ``failed_in_hold`` (bool), ``t_slip`` (time from the hold's start to the slip),
-        ``hold_hops``, ``events``; ``creep`` (float64 [k, 1 + n]: time since the hold's start and
-        ``R_a - R_a(start)`` per interface [length] after each of the ``k`` hops within the hold);
+        ``hold_hops``, ``events``; ``creep`` (float64 [k, 1 + n]: time since the hold's start and the
+        slip of every interface since then in well hops of its blocks (Gauss point 0), after each of the
+        ``k`` hops within the hold);
         ``barriers_start``, ``barriers_end`` (float64 [ni]: forward barrier of every block /
         temperature, at the start and the end of the hold).
     """
@@ -78,7 +79,7 @@ def hold_trial(system, state, hold_time, below, replica):
     interfaces = range(1, p.plates)
     names = [f"sigd_{2 * a - 1}" for a in interfaces]
     start = observer.observe(observer.well_index())
-    r0 = _slips(system, interfaces)
+    r0 = _slips(observer)
     barriers_start = barriers_end = _barriers(system, unit)
     previous = observer.well_index()
     creep = []
@@ -94,7 +95,7 @@ def hold_trial(system, state, hold_time, below, replica):
         previous = observer.well_index()
         if t < hold_time:
             result["hold_hops"] += 1
-            creep.append([t, *(_slips(system, interfaces) - r0)])
+            creep.append([t, *(_slips(observer) - r0)])
             barriers_end = _barriers(system, unit)
         slipping = [a for a in interfaces if event[f"A_a{a}"] == p.N]
         if slipping:
