@@ -8,6 +8,7 @@ Reads a thermal study's ``thermal-events`` outputs (``STUDY/events/thermal-event
 
 - per fem run: events (hops, athermal kicks, failed and backward hops), steady-state slips per interface,
   mean drop and peak stress of the single slips (standard errors);
+- the runs with hold cycles: Delta mu against the waiting time through both aging fits, and per hold;
 - the stacks at ``--drive-rate``: the aging fits (origin, intercept; T0 = 1 / attempt_rate) pooled per n
   and per interface, B_a per interface, std(B_a) normalised by n = 1; the same of the virtual experiment
   (stacks n <= 3, T0 = 1 s) with its R_slow;
@@ -95,6 +96,20 @@ def stacks(runs, params, events):
     print(interfaces.groupby(["n", "a"])["R_slow"].agg(["mean", "sem", "size"]).to_string())
 
 
+def cycles(runs):
+    """The runs with hold cycles: Delta mu against the waiting time (aging fits), and per hold time."""
+    for _, run in runs[runs["thermal"] & runs["holds"]].iterrows():
+        slips = run["data"].tables["slip_events"]
+        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
+        T = slips["T"].to_numpy()
+        print(f"== hold cycles, {Path(run['file']).stem}: {len(slips)} single slips with a T, nu T from "
+              f"{T.min() / run['T0']:.3g} to {T.max() / run['T0']:.3g}")
+        print(f"    {fits(T, slips['dmu'].to_numpy(), run['T0'])}")
+        held = slips.assign(hold=np.where(slips["hold"] > 0, slips["hold"], 0.0).round(-3))
+        print(held.groupby("hold").agg(slips=("dmu", "size"), dmu=("dmu", "mean"), dmu_std=("dmu", "std"),
+                                       peak=("mu_before", "mean")).to_string())
+
+
 def comparisons(runs, params, events):
     print("== Delta mu_a / <Delta mu>_(n=1) against T_a / <T_a>_(n=1), intercept fit")
     table = figs_thermal.scaled_slips(runs, params, load_slips(events) if events else None)
@@ -156,6 +171,7 @@ def main():
     params = parse_params(figs_thermal.FigsThermalParams, {"drive_rate": args.drive_rate})
     runs_summary(runs, args.study)
     stacks(runs, params, events)
+    cycles(runs)
     comparisons(runs, params, events)
     holds(runs)
 
