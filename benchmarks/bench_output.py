@@ -7,9 +7,9 @@ Usage::
 Three workloads, each with and without the ``fletcher32`` checksum (:func:`stickslip.h5io.write_dataset`):
 
 - ``timeseries``: a lever recording (the default lever run, 6000 s: 300001 force samples and
-  30001 frames of 5 slabs, gzip) written through :func:`stickslip.h5io.atomic_output`, then read back.
+  30001 frames of 5 slabs, gzip) written through :func:`stickslip.output_safety.atomic.atomic_output`, then read back.
 - ``fem-append``: 400 increments of the paper's ``N = 1458``, 2 plates (``u``: 23 334 doubles a
-  row, chunk one row) appended and flushed one at a time, as :func:`stickslip.fem.output.append_increment` does.
+  row, chunk one row) appended and flushed one at a time, as :func:`stickslip.formats.fem_run.append_increment` does.
 - ``fem-copy``: those rows copied by :func:`stickslip.h5io.copy_file` (the rewrite on resume and
   completion), through the write guard (the package's writer of new files) and through HDF5's
   own file driver (``sec2``, what new files were written with before).
@@ -28,6 +28,7 @@ import h5py
 import numpy as np
 
 from stickslip import h5io
+from stickslip.output_safety.atomic import atomic_output
 
 
 def timed(function, repeat):
@@ -46,7 +47,7 @@ def timeseries(directory, checksum):
     path = directory / "lab.h5"
 
     def run():
-        with h5io.atomic_output(path) as tmp, h5io.open_file(tmp, "w") as file:
+        with atomic_output(path) as tmp, h5io.open_file(tmp, "w") as file:
             for name, values in series.items():
                 h5io.write_dataset(file, name, values, compression="gzip", compression_opts=4, shuffle=True,
                                    fletcher32=checksum)

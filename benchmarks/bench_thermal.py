@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from stickslip.events.extraction import classify_increments
-from stickslip.fem.output import read_increments
+from stickslip.formats.fem_run import read_increments
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.replay import EventReplay
 from stickslip.fem.thermal import drive_scale, energy_unit, sample_event

@@ -56,14 +56,14 @@ from scipy import sparse, stats
 from scipy.sparse.linalg import eigsh
 
 from stickslip import registry
-from stickslip.events.extraction import classify_increments, slip_events, slip_interfaces
+from stickslip.events.extraction import classify_increments, slip_interfaces, steady_slips
 from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
-from stickslip.fem.observables import Observer
-from stickslip.fem.output import RunFile, read_increments, read_run_attrs
 from stickslip.fem.backends import make_backend
+from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.stiffness import stiffness_ratio
 from stickslip.fem.system import System
+from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
@@ -155,7 +155,7 @@ def _slip_sample(label, params, args):
     classified = classify_increments(table, N)
     if args.start is not None:  # instead of the extraction's steady state (needs every interface to slip once)
         classified["steady"] = classified["increment"].to_numpy() >= args.start
-    slips = slip_events(classified, N)
+    slips = steady_slips(classified, N)
     counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
     drops = slip_interfaces(classified, N)["dmu"].to_numpy()
     events = classified["kick"].to_numpy() & classified["steady"].to_numpy(dtype=bool)

@@ -29,7 +29,7 @@ import pandas as pd
 from stickslip.experiment.aging import fit_aging, spread_of_aging_rate
 from stickslip.figures import figs_thermal
 from stickslip.figures.experimental_data import load_interfaces, load_slips
-from stickslip.fem.output import read_increments
+from stickslip.formats.fem_run import read_increments
 from stickslip.params import parse_params
 
 

@@ -1,4 +1,4 @@
-"""HDF5 helpers shared by every module that writes files: reproducible bytes and tables.
+"""HDF5 reading and writing: reproducible bytes, checksummed datasets, tables, and the errors of input files.
 
 Bit-identical outputs for the same inputs need two things from HDF5: no
 modification times in object headers (``track_times=False``) and a fixed
@@ -9,35 +9,31 @@ Files that a long run appends to (:mod:`stickslip.fem.run`) are written in
 HDF5's single-writer/multiple-reader (SWMR) mode, so that a killed writer leaves a
 readable file: :func:`open_file` reads such a file (running, or left "open for
 write" by a killed process) through SWMR, :func:`copy_file` rewrites it into a
-fresh file whose bytes depend only on its contents, and :func:`writer_lock` keeps
-a second process from writing the same file.
+fresh file whose bytes depend only on its contents, and
+:func:`stickslip.output_safety.lock.writer_lock` keeps a second process from writing the same file.
 
 Tables (event lists, per-increment observables) are stored as a group with one
 1-D dataset per column and the column order in the attribute ``columns``;
 :func:`write_table` and :func:`read_table` convert to and from
 :class:`pandas.DataFrame`.
+
+What keeps outputs safe (atomic renames, locks, free space, the write guard through which
+:func:`open_file` writes a new file) is :mod:`stickslip.output_safety`.
 """
 
-import errno
-import fcntl
 import json
-import os
-import re
-import shutil
-import tempfile
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pandas as pd
 
-from .write_guard import WriteGuard
+from .output_safety.errors import OutputError
+from .output_safety.write_guard import WriteGuard
 
-__all__ = ["open_file", "write_dataset", "read_array", "write_table", "read_table", "write_attrs", "atomic_output",
-           "copy_file", "writer_lock", "FileFormatError", "UnreadableFileError", "CorruptFileError", "OutputError",
-           "check_output", "check_free_space"]
+__all__ = ["open_file", "write_dataset", "read_array", "write_table", "read_table", "write_attrs", "copy_file",
+           "FileFormatError", "UnreadableFileError", "CorruptFileError"]
 
 LIBVER = ("v110", "v110")
 
@@ -49,10 +45,6 @@ _CHECKSUMMED_KINDS = "biufcS"
 
 #: Reads of a dataset of a file being written (SWMR) before a failed checksum counts as damage.
 _SWMR_READ_ATTEMPTS = 4
-
-#: errno values that mean "the output cannot be written", reported as :class:`OutputError`.
-_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOENT,
-                 errno.ENOTDIR, errno.EISDIR)
 
 #: Bytes per block in which :func:`copy_file` copies a dataset (bounded memory).
 _COPY_BLOCK_BYTES = 64 * 2**20
@@ -70,22 +62,6 @@ class CorruptFileError(FileFormatError):
     """Stored data fails its checksum or cannot be decompressed: the file is damaged."""
 
 
-class OutputError(OSError):
-    """An output file cannot be written (full disk, no permission, read-only file system); the message says which.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The output file.
-    code : int
-        The ``errno`` of the failure.
-    """
-
-    def __init__(self, path, code):
-        super().__init__(f"{path}: cannot write it ({os.strerror(code)})")
-        self.errno = code
-
-
 def open_file(path, mode="r"):
     """Open an HDF5 file with the package's reproducible settings.
 
@@ -101,17 +77,20 @@ def open_file(path, mode="r"):
 
     Reading (``"r"``) takes no HDF5 file lock, so that a reader never stops a writer
     from opening the file (every writer of the package either writes a temporary
-    file and renames it, :func:`atomic_output`, or appends under
-    :func:`writer_lock`). A file whose writer is running, or was killed, in SWMR
-    mode is opened as an SWMR reader: it shows what the writer had flushed.
+    file and renames it, :func:`~stickslip.output_safety.atomic.atomic_output`, or
+    appends under :func:`~stickslip.output_safety.lock.writer_lock`). A file whose
+    writer is running, or was killed, in SWMR mode is opened as an SWMR reader: it
+    shows what the writer had flushed.
 
-    A new file (``"w"``) is written through a :class:`~stickslip.write_guard.WriteGuard`,
-    so that a failed write (full disk) raises :class:`OutputError` from
+    A new file (``"w"``) is written through a
+    :class:`~stickslip.output_safety.write_guard.WriteGuard`, so that a failed write
+    (full disk) raises :class:`~stickslip.output_safety.errors.OutputError` from
     :meth:`~h5py.File.flush` or :meth:`~h5py.File.close`, where HDF5 itself would
     crash; the file is then incomplete. An existing file (``"r+"``) is opened
     directly: the guard's file driver would not mark the file as open for writing
     in the way SWMR readers need (HDF5 sets that flag with its file lock only);
-    its writer checks the free space itself (:func:`check_free_space`).
+    its writer checks the free space itself
+    (:func:`~stickslip.output_safety.space.check_free_space`).
 
     Raises
     ------
@@ -140,8 +119,8 @@ def open_file(path, mode="r"):
 
 
 class _GuardedFile(h5py.File):
-    """An HDF5 file written through a :class:`~stickslip.write_guard.WriteGuard`: a failed write
-    (full disk) raises :class:`OutputError` from :meth:`flush` and :meth:`close`."""
+    """An HDF5 file written through a :class:`~stickslip.output_safety.write_guard.WriteGuard`: a failed write
+    (full disk) raises :class:`~stickslip.output_safety.errors.OutputError` from :meth:`flush` and :meth:`close`."""
 
     def __init__(self, guard):
         try:
@@ -304,177 +283,6 @@ def read_table(group, name, rows=None):
     return pd.DataFrame(data, columns=columns)
 
 
-@contextmanager
-def atomic_output(path):
-    """Write a file under a temporary name and rename it into place on success.
-
-    An interrupted or failing writer leaves the previous file (or none) intact, and
-    no temporary file. The temporary file ``.<name>.<random>.tmp`` is locked
-    (``flock``) while it is written; temporaries of ``path`` that no live process
-    holds (left by a process that was killed) are removed first.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        Final path.
-
-    Yields
-    ------
-    pathlib.Path
-        Temporary path in the same directory, to write to.
-
-    Raises
-    ------
-    OutputError
-        If the file cannot be written (full disk, no permission, read-only file
-        system, ``path`` a directory); the message names ``path`` and the cause.
-    """
-    path = Path(path)
-    with _output_errors(path):
-        _make_directory(path)
-        _remove_stale_temporaries(path)
-        fd, tmp = _locked_temporary(path)
-    umask = os.umask(0)
-    os.umask(umask)
-    try:
-        with _output_errors(path):
-            yield tmp
-            if tmp.exists():  # mkstemp makes it private; the result gets the usual permissions
-                os.chmod(tmp, 0o666 & ~umask)
-            os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-        os.close(fd)
-
-
-def check_output(path):
-    """Raise now if ``path`` cannot be written, before a long computation would find it out.
-
-    Makes the missing directories and a temporary file beside ``path`` (removed again).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-
-    Raises
-    ------
-    OutputError
-        If ``path`` is a directory, or its directory cannot be made or written to.
-    """
-    path = Path(path)
-    with _output_errors(path):
-        _make_directory(path)
-        fd, tmp = _locked_temporary(path)
-        tmp.unlink()
-        os.close(fd)
-
-
-def check_free_space(path, nbytes):
-    """Raise OutputError (ENOSPC) unless the file system of ``path`` has ``nbytes`` free.
-
-    For a writer that appends to an existing file in place, where a write that fails
-    for lack of space would crash HDF5: checked before each append, with a margin,
-    it ends the writer cleanly instead. (Space taken by another process between the
-    check and the write, and quotas, which the check does not see, are not covered.)
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The file appended to.
-    nbytes : int
-        Bytes needed [B].
-
-    Raises
-    ------
-    OutputError
-        If less is free (for unprivileged users).
-    """
-    if shutil.disk_usage(Path(path).parent).free < nbytes:
-        raise OutputError(path, errno.ENOSPC)
-
-
-def _make_directory(path):
-    """Make the directory of the output file ``path`` (IsADirectoryError if ``path`` is one)."""
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR))
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:  # a file where a directory should be
-        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR)) from None
-
-
-@contextmanager
-def _output_errors(path):
-    """Turn an OSError of writing into :class:`OutputError` naming ``path``."""
-    try:
-        yield
-    except OSError as error:
-        if error.errno not in _WRITE_ERRNOS:
-            raise
-        raise OutputError(path, error.errno) from error
-
-
-def _temporary_name(path):
-    """Pattern of the names :func:`tempfile.mkstemp` gives the temporaries of ``path``."""
-    return re.compile(rf"\.{re.escape(path.name)}\.[a-z0-9_]{{8}}\.tmp")
-
-
-def _locked_temporary(path):
-    """Create a temporary file beside ``path`` and lock it; return (descriptor, path).
-
-    The lock is taken after the file appears, so :func:`_remove_stale_temporaries`
-    of another process may lock and remove it in between; it is then made again.
-    """
-    while True:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        fcntl.flock(fd, fcntl.LOCK_EX)
-        if _same_file(fd, tmp):
-            return fd, Path(tmp)
-        os.close(fd)
-
-
-def _same_file(fd, path):
-    """Whether ``path`` is (still) the file open as ``fd``."""
-    try:
-        return os.path.samestat(os.fstat(fd), os.stat(path))
-    except FileNotFoundError:
-        return False
-
-
-def _remove_stale_temporaries(path):
-    """Remove the temporaries of :func:`atomic_output` for ``path`` that no process holds.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        Final path; its directory is searched for ``.<name>.<random>.tmp``.
-
-    Returns
-    -------
-    list of pathlib.Path
-        The files removed.
-    """
-    pattern = _temporary_name(path)
-    removed = []
-    for candidate in sorted(path.parent.iterdir()):
-        if not pattern.fullmatch(candidate.name):
-            continue
-        try:
-            fd = os.open(candidate, os.O_RDONLY)
-        except FileNotFoundError:
-            continue
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            if _same_file(fd, candidate):
-                candidate.unlink()
-                removed.append(candidate)
-        except BlockingIOError:
-            pass
-        finally:
-            os.close(fd)
-    return removed
-
-
 def copy_file(source, target, rows):
     """Copy every group, dataset and attribute of ``source`` into the empty file ``target``.
 
@@ -518,29 +326,3 @@ def copy_file(source, target, rows):
     copy_group(source, target)
 
 
-@contextmanager
-def writer_lock(path):
-    """Hold an exclusive lock on writing ``path`` (released when the process ends, even if killed).
-
-    The lock is the hidden file ``.<name>.lock`` beside ``path``, removed on exit.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-
-    Raises
-    ------
-    FileFormatError
-        If another process holds the lock.
-    """
-    path = Path(path)
-    lock = path.parent / f".{path.name}.lock"
-    with open(lock, "a") as handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise FileFormatError(f"{path}: another process is writing it (lock {lock})") from None
-        try:
-            yield
-        finally:
-            lock.unlink(missing_ok=True)

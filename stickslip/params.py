@@ -26,6 +26,7 @@ defaults, and stored (with the run id keyed on it) as soon as either has another
 """
 
 import dataclasses
+import difflib
 import math
 import typing
 from collections.abc import Iterable
@@ -34,6 +35,7 @@ __all__ = [
     "ParameterError",
     "param",
     "parse_params",
+    "did_you_mean",
     "parse_assignments",
     "params_to_dict",
     "json_schema",
@@ -189,8 +191,8 @@ def parse_params(cls, values=None, *, owner=""):
     if unknown:
         where = f" of {owner}" if owner else ""
         raise ParameterError(
-            f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}{where}; "
-            f"allowed: {', '.join(types)}")
+            f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}{where}"
+            f"{did_you_mean(unknown[0], types)}; allowed: {', '.join(types)}")
     kwargs = {}
     for f in dataclasses.fields(cls):
         if f.name in values:
@@ -228,6 +230,22 @@ def parse_assignments(assignments):
             raise ParameterError(f"parameter '{key}' is given twice")
         values[key] = value.strip()
     return values
+
+
+def did_you_mean(name, choices):
+    """`` (did you mean 'x'?)`` for the choice closest to a misspelt ``name``; empty if none is close.
+
+    Parameters
+    ----------
+    name : str
+    choices : Iterable[str]
+
+    Returns
+    -------
+    str
+    """
+    close = difflib.get_close_matches(name, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def params_to_dict(instance):

@@ -39,15 +39,21 @@ _LOG_FORMAT = {
 
 
 class _Lines:
-    """A stream that receives tqdm's carriage-return redraws as whole lines (for logs)."""
+    """A stream that receives tqdm's carriage-return redraws as whole lines (for logs).
+
+    A line equal to the one before is not written again (tqdm draws the last state once more on
+    closing: after an error at the start, that was the first line twice).
+    """
 
     def __init__(self, stream):
         self.stream = stream
+        self.last = None
 
     def write(self, text):
         text = text.replace("\r", "").rstrip()
-        if text:
+        if text and text != self.last:
             self.stream.write(text + "\n")
+            self.last = text
 
     def flush(self):
         self.stream.flush()

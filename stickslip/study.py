@@ -40,7 +40,7 @@ from .params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import record_path
 
-__all__ = ["RESULTS", "PATHS", "study_name", "Simulation", "AnalysisJob", "FigureJob", "Study", "plugin_sections",
+__all__ = ["RESULTS", "PATHS", "study_name", "SimulationJob", "AnalysisJob", "FigureJob", "Study", "plugin_sections",
            "normalise", "check_sweeps"]
 
 #: Directory of the studies' results trees (relative to the workflow's working directory).
@@ -90,7 +90,7 @@ SECTIONS = {"solvers": "solver", "analyses": "analysis", "figures": "figure"}
 
 
 @dataclasses.dataclass(frozen=True)
-class Simulation:
+class SimulationJob:
     """One solver run.
 
     Attributes
@@ -124,7 +124,7 @@ class AnalysisJob:
     """One analysis of one simulation output (``path``: the output file, of ``format``)."""
 
     analysis: str
-    simulation: Simulation
+    simulation: SimulationJob
     run_id: str
     path: str
     format: str
@@ -263,6 +263,9 @@ def check_sweeps(config):
                 raise ParameterError(f"config {where}: parameter '{both[0]}' is in both params "
                                      f"({params[both[0]]!r}) and grid ({grid[both[0]]!r}); expected it in one of them")
             for key, values in grid.items():
+                if not isinstance(values, list):
+                    raise ParameterError(f"config {where}.grid.{key}: expected a list of values, got {values!r} "
+                                         f"(write [{values!r}], or put it in params)")
                 for j, value in enumerate(values):
                     if value in values[:j]:
                         raise ParameterError(f"config {where}.grid.{key}: value {value!r} is listed twice; "
@@ -302,7 +305,7 @@ class Study:
     root : str
         Its results tree, ``results/{name}``: every output, log and the database.
     threads : int
-    simulations : list[Simulation]
+    simulations : list[SimulationJob]
         Sorted by solver, then run id; no duplicates.
     meshes : dict[str, dict]
         Mesh id -> mesh parameters.
@@ -342,7 +345,7 @@ class Study:
                     if "mesh" in plugin.consumes:
                         mesh_id, mesh_params = _mesh_for(as_dict)
                         self.meshes[mesh_id] = mesh_params
-                    runs[(name, run)] = Simulation(name, run, as_dict, self.path("simulation", solver=name, run_id=run),
+                    runs[(name, run)] = SimulationJob(name, run, as_dict, self.path("simulation", solver=name, run_id=run),
                                                    plugin.produces, mesh_id)
         return [runs[key] for key in sorted(runs)]
 
@@ -427,7 +430,7 @@ class Study:
         return f"{self.root}/{PATHS['logs']}/{name}.log"
 
     def simulation(self, solver, run_id):
-        """Return the :class:`Simulation` with this solver and run id (KeyError if none)."""
+        """Return the :class:`SimulationJob` with this solver and run id (KeyError if none)."""
         for sim in self.simulations:
             if sim.solver == solver and sim.run_id == run_id:
                 return sim

@@ -7,7 +7,18 @@ Every function writes a log, checks that its input files are readable HDF5
 writes the JSON record beside the output (:mod:`stickslip.provenance.record`).
 Jobs receive their inputs with their lineage (:class:`stickslip.lineage.Artifact`
 as JSON: run id, producer, format, parent) and record it; nothing is read back
-from a path.
+from a path. An output that exists when a job starts (Snakemake deletes those of
+the jobs it runs) must be the output of the same run, by the run id of its
+record, or the job refuses it (:func:`stickslip.output_safety.overwrite.refuse_other_run`,
+the rule of every command that writes a file).
+
+A simulation is written under :func:`partial_path` until it is complete, and the
+completed file keeps that second name (a hard link: no extra space) with its
+record beside it, so that a job which completed while Snakemake was stopped
+(Ctrl-C, a lost connection: Snakemake then deletes its outputs and runs it again)
+is found complete by the rerun instead of being recomputed, unless its code
+changed. :func:`release_completed` drops those second names once a workflow run
+has succeeded.
 
 This module imports nothing that imports numba: :func:`prepare_environment`
 must set the numba variables before the first plugin is loaded.
@@ -25,14 +36,19 @@ from pathlib import Path
 
 from . import registry
 from .h5io import FileFormatError, open_file
+from .hashing import sha256_file
 from .lineage import Artifact
+from .output_safety.overwrite import refuse_other_run
 from .params import params_to_dict, parse_params
 from .provenance.code import code_hash
-from .provenance.record import recording
-from .termination import sigterm_as_interrupt
+from .provenance.record import read_record, recording
+from .termination import interrupts_raised
 
-__all__ = ["prepare_environment", "partial_path", "run_mesh", "run_simulation", "run_analysis", "run_figure",
-           "build_database"]
+__all__ = ["prepare_environment", "partial_path", "kept_record", "run_mesh", "run_simulation", "run_analysis",
+           "run_figure", "build_database", "release_completed"]
+
+#: What a job says about an existing output of another run (jobs have no ``--overwrite``).
+_NOT_THIS_JOBS = "it is not this job's output: move it away (or delete it) and rerun"
 
 
 def prepare_environment(threads, numba_cache="shared"):
@@ -75,12 +91,13 @@ def prepare_environment(threads, numba_cache="shared"):
 def _logged(log):
     """Send stdout and stderr to ``log``; a failure's traceback goes there too, then propagates.
 
-    SIGTERM (Snakemake, ``scancel``, a wall time) ends the job as Ctrl-C does: files are closed.
+    Ctrl-C and SIGTERM (Snakemake, ``scancel``, a wall time) end the job at any moment, numba's
+    compilation included (:func:`stickslip.termination.interrupts_raised`): files are closed.
     """
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w", encoding="utf-8") as stream:
         try:
-            with contextlib.redirect_stdout(stream), contextlib.redirect_stderr(stream), sigterm_as_interrupt():
+            with contextlib.redirect_stdout(stream), contextlib.redirect_stderr(stream), interrupts_raised():
                 yield stream
         except BaseException:
             stream.write(traceback.format_exc())
@@ -110,11 +127,30 @@ def _artifacts(value):
     return {key: _artifacts(item) for key, item in value.items()}
 
 
-def _plugin_recording(record, outputs, plugin, params, run_id, **extra):
-    """:func:`recording` of a plugin run: identity, version and code hash from the plugin."""
+def _plugin_recording(record, outputs, plugin, params, run_id, *, code=None, **extra):
+    """:func:`recording` of a plugin run: identity, version and code hash (``code``, or computed) of the plugin.
+
+    An output that exists already must be the output of ``run_id`` (:func:`_refuse_other_outputs`).
+    """
+    _refuse_other_outputs([path for _, path, *_ in outputs], record, run_id)
     return recording(record, outputs, run_id=run_id, kind=plugin.kind, plugin=plugin.name,
-                     plugin_version=plugin.version, code_hash=code_hash(plugin.module),
+                     plugin_version=plugin.version, code_hash=code or code_hash(plugin.module),
                      params=params_to_dict(params), **extra)
+
+
+def _refuse_other_outputs(outputs, record, run_id):
+    """Raise OutputExistsError if one of ``outputs`` exists and its record ``record`` is not of ``run_id``."""
+    def recorded(path, names):
+        try:
+            return {"run_id": read_record(record)["run_id"]}
+        except FileFormatError:
+            return {}
+
+    def describe(stored):
+        return "the output of another job" if stored else f"a file without its provenance record {record}"
+
+    for path in outputs:
+        refuse_other_run(path, {"run_id": run_id}, hint=_NOT_THIS_JOBS, read=recorded, describe=describe)
 
 
 def _load(kind, name, params_json, module):
@@ -174,19 +210,106 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         from .numba_options import set_num_threads
 
         plugin, params = _load("solver", solver, params_json, module)
+        run_id, code = registry.run_id(plugin, params), code_hash(plugin.module)
+        output, partial = Path(output), partial_path(output)
+        _refuse_other_outputs([output], record, run_id)
+        if _completed_before(partial, run_id, code):
+            _publish(partial, output)
+            _publish(kept_record(partial), Path(record))
+            print(f"{plugin.name} run {run_id}: completed by an earlier job ({partial}), not recomputed")
+            return
         inputs = _artifacts(inputs)
         for role, path in inputs.items():
             _check_hdf5(role, path)
         used = set_num_threads(threads)
-        with _plugin_recording(record, [("output", output, plugin.produces)], plugin, params,
-                               registry.run_id(plugin, params), threads=used, inputs=sorted(inputs.items())) as job:
+        with _plugin_recording(record, [("output", output, plugin.produces)], plugin, params, run_id, code=code,
+                               threads=used, inputs=sorted(inputs.items())) as job:
             print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(job['params'])}")
-            partial = partial_path(output)
             partial.parent.mkdir(parents=True, exist_ok=True)
             if partial.exists():
                 print(f"resuming from {partial}")
             plugin.run(params, partial, threads=used, inputs={k: v.path for k, v in inputs.items()})
-            os.replace(partial, output)
+            kept = _publish(partial, output)
+        if kept:
+            _publish(Path(record), kept_record(partial))
+
+
+def kept_record(partial):
+    """The copy of a completed simulation's provenance record beside its second name ``partial``.
+
+    Named ``<run_id>.kept.json``, not ``*.provenance.json``: the database's rebuild reads those.
+    """
+    return partial.with_suffix(".kept.json")
+
+
+def _completed_before(partial, run_id, code):
+    """Whether ``partial`` holds run ``run_id`` completed by code ``code`` (its kept record says so).
+
+    A kept file of other code (or whose bytes no longer match its record) is removed: the run is
+    made again.
+    """
+    kept = kept_record(partial)
+    if not (partial.is_file() and kept.is_file()):
+        return False
+    try:
+        record = read_record(kept)
+        same = (record["run_id"] == run_id and record["code_hash"] == code
+                and record["outputs"][0]["sha256"] == sha256_file(partial))
+    except FileFormatError:
+        same = False
+    if not same:
+        print(f"{partial}: completed by other code (or changed since); made again")
+        partial.unlink()
+        kept.unlink()
+    return same
+
+
+def _publish(source, target):
+    """Give ``source`` the second name ``target`` (a hard link, replacing ``target`` atomically).
+
+    Where the file system has no hard links, ``source`` is renamed to ``target``.
+
+    Returns
+    -------
+    bool
+        Whether ``source`` keeps its name (it is linked, not renamed).
+    """
+    link = target.with_name(f".{target.name}.{os.getpid()}.link")
+    link.unlink(missing_ok=True)
+    try:
+        os.link(source, link)
+    except OSError:
+        os.replace(source, target)
+        return False
+    os.replace(link, target)
+    return True
+
+
+def release_completed(root):
+    """Drop the second names (in ``partial/``) of the completed simulations of a study whose outputs are in place.
+
+    Call when a workflow run has succeeded: Snakemake then holds every job it ran as complete, so
+    no rerun will need to find them (:func:`run_simulation`).
+
+    Parameters
+    ----------
+    root : str or pathlib.Path
+        The study's results tree, ``results/{study}``.
+
+    Returns
+    -------
+    int
+        Number of simulations released.
+    """
+    released = 0
+    for kept in sorted(Path(root).glob("sim/*/partial/*.kept.json")):
+        partial = kept.parent / Path(read_record(kept)["outputs"][0]["path"]).name
+        output = kept.parent.parent / partial.name
+        if partial.is_file() and output.is_file() and os.path.samefile(partial, output):
+            partial.unlink()
+            kept.unlink()
+            released += 1
+    return released
 
 
 def partial_path(output):

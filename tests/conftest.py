@@ -1,6 +1,7 @@
-"""Shared fixtures: the toy plugin distribution (entry points) and a workflow copy."""
+"""Shared fixtures: the toy plugin distribution (entry points) and a workflow copy; test groups for pytest-xdist."""
 
 import json
+import os
 import shutil
 import sys
 import tempfile
@@ -51,6 +52,57 @@ def toy_plugins(toy_distribution, monkeypatch):
     monkeypatch.syspath_prepend(str(toy_distribution))
     monkeypatch.setattr(registry, "_loaded", False)
     return toy_distribution
+
+
+@pytest.fixture(autouse=True)
+def numba_threads_variable():
+    """Restore ``NUMBA_NUM_THREADS`` after every test.
+
+    The workflow's job functions set it for their process (``workflow_api.prepare_environment``); in
+    the test process a changed value makes numba's next compilation fail ("Cannot set
+    NUMBA_NUM_THREADS to a different value once the threads have been launched"), in whichever test
+    of the same process (pytest-xdist worker) compiles next.
+    """
+    saved = os.environ.get("NUMBA_NUM_THREADS")
+    yield
+    if saved is None:
+        os.environ.pop("NUMBA_NUM_THREADS", None)
+    else:
+        os.environ["NUMBA_NUM_THREADS"] = saved
+
+
+#: Test modules that share a costly session fixture, by the fixture: pytest-xdist runs each set in one worker.
+SHARED = {"ci_study": ("test_workflow_smoke", "test_slurm", "test_docs_queries"),
+          "fem_reference_run": ("test_fem_reference", "test_fem_kill")}
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """CI's two workers (``pytest -n 2``, .ci/run): each test module runs in one worker, so its module fixtures
+    are made once, and the modules of one :data:`SHARED` set run in one worker, so its session fixture is too.
+
+    (pytest-xdist's own ``--dist loadgroup`` groups nothing under pytest 9: it renames node ids through an
+    attribute pytest 9 no longer reads.)
+    """
+    from xdist.scheduler import LoadScopeScheduling
+
+    groups = {module: fixture for fixture, modules in SHARED.items() for module in modules}
+
+    class ModuleGroups(LoadScopeScheduling):
+        def _split_scope(self, nodeid):
+            module = nodeid.split("::", 1)[0]
+            return groups.get(Path(module).stem, module)
+
+    return ModuleGroups(config, log)
+
+
+def pytest_collection_modifyitems(items):
+    """Fail the run if a module uses a fixture of :data:`SHARED` without being listed with it."""
+    for item in items:
+        for fixture, modules in SHARED.items():
+            if fixture in item.fixturenames and item.module.__name__ not in modules:
+                raise pytest.UsageError(f"{item.module.__name__} uses the session fixture {fixture}: add it to "
+                                        f"tests/conftest.py SHARED[{fixture!r}]")
 
 
 def copy_workflow(destination):
@@ -136,3 +188,23 @@ def ci_study():
     snakemake(directory, "--cores", "2", "--configfile", "workflow/config/ci.yaml")
     yield directory
     shutil.rmtree(directory, ignore_errors=True)
+
+
+@pytest.fixture
+def drawn_figures(monkeypatch):
+    """The matplotlib figures that a figure plugin saves during the test, in order (read their plotted data).
+
+    A plugin closes its figure after saving it (:func:`stickslip.figures.style.save_figure`); the
+    closed figure keeps its axes, lines and texts.
+    """
+    from matplotlib.figure import Figure
+
+    drawn, savefig = [], Figure.savefig
+
+    def recording_savefig(figure, *args, **kwargs):
+        if not any(figure is seen for seen in drawn):
+            drawn.append(figure)
+        return savefig(figure, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", recording_savefig)
+    return drawn

@@ -2,7 +2,7 @@
 
 Real failures: a file-size limit (``RLIMIT_FSIZE``, ``EFBIG``; any user) and, as root, a real
 tmpfs of 1 MB (``ENOSPC``) and a read-only one (``EROFS``). Before the write guard
-(:mod:`stickslip.write_guard`) the lever run on a full tmpfs ended in a segmentation fault.
+(:mod:`stickslip.output_safety.write_guard`) the lever run on a full tmpfs ended in a segmentation fault.
 """
 
 import hashlib
@@ -17,8 +17,9 @@ from contextlib import contextmanager
 import pytest
 
 from stickslip import h5io
-from stickslip.fem.output import RunFile
 from stickslip.fem.run import FREE_SPACE_MARGIN
+from stickslip.formats.fem_run import RunFile
+from stickslip.output_safety.atomic import atomic_output
 
 LEVER = ["simulate", "--solver", "lever", "--param", "n=2", "--param", "duration=600"]
 
@@ -97,7 +98,8 @@ def test_an_output_that_is_a_directory_or_under_no_directory_is_refused_at_once(
 WRITER = textwrap.dedent("""
     import os, signal, sys, time
     from stickslip import h5io
-    with h5io.atomic_output(sys.argv[1]) as tmp, h5io.open_file(tmp, "w") as f:
+    from stickslip.output_safety.atomic import atomic_output
+    with atomic_output(sys.argv[1]) as tmp, h5io.open_file(tmp, "w") as f:
         h5io.write_dataset(f, "x", list(range(100)))
         f.flush()
         print(tmp.name, flush=True)
@@ -123,7 +125,7 @@ def test_temporaries_of_killed_writers_are_removed_those_of_live_ones_kept(tmp_p
         assert sorted([stale, running]) == leftovers(tmp_path)
         other = tmp_path / ".other.h5.abcdefgh.tmp"  # another output's temporary: not ours to remove
         other.touch()
-        with h5io.atomic_output(output) as tmp:
+        with atomic_output(output) as tmp:
             assert sorted([running, tmp.name, other.name]) == leftovers(tmp_path)
             tmp.write_bytes(b"done")
         assert output.read_bytes() == b"done"
@@ -131,7 +133,7 @@ def test_temporaries_of_killed_writers_are_removed_those_of_live_ones_kept(tmp_p
     finally:
         live.kill()
         live.wait()
-    with h5io.atomic_output(output) as tmp:
+    with atomic_output(output) as tmp:
         pass
     assert leftovers(tmp_path) == [other.name]
 
@@ -151,8 +153,10 @@ def test_a_fem_run_stops_cleanly_before_the_disk_is_full_and_resumes_to_the_same
         output = disk / "run.h5"
         process = stickslip(fem + ["-o", str(output)])
         assert process.returncode == 2
-        assert [line for line in process.stderr.splitlines() if "fem increments" not in line] == [
-            f"stickslip: error: {output}: cannot write it (No space left on device)"]
+        lines = [line for line in process.stderr.splitlines() if "fem increments" not in line]
+        assert len(lines) == 1 and lines[0].startswith(f"stickslip: error: {output}: cannot write it: ")
+        assert (f"free, the next write needs {needed / 2**20:.2f} MiB, 4.00 MiB of it a safety margin kept free: "
+                f"HDF5 crashes on a full disk; free some space and rerun") in lines[0]
         with h5io.open_file(output) as file:
             assert 0 < file.attrs["nstored"] < 150
         filler.unlink()

@@ -1,7 +1,7 @@
 """Event extraction on synthetic increment tables with known answers.
 
 :func:`history` builds the table a quasistatic ``fem`` run would give for a scripted
-sequence of events; other test modules import it.
+sequence of events, :func:`run_attrs` the header of its file; other test modules import them.
 """
 
 import numpy as np
@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from stickslip.events import extraction as ex
+from stickslip.fem.stiffness import driving_regime, stiffness_ratio
 from stickslip.h5io import FileFormatError
 
 
@@ -57,6 +58,14 @@ def history(N, events, *, load_gamma=1.0, elastic_modulus=1.0):
     return table
 
 
+def run_attrs(N, plates, k_drive, **further):
+    """Root attributes of a synthetic ``fem`` run file: its typed header with ``phi`` and ``regime``
+    as the solver states them (:mod:`stickslip.fem.stiffness`), then ``further``."""
+    phi = stiffness_ratio(k_drive, N)
+    return {"N": N, "plates": plates, "n_interfaces": plates - 1, "k_drive": k_drive, "phi": phi,
+            "regime": driving_regime(phi), **further}
+
+
 N = 9
 MICRO = ((3, 0), (0.0, 0.0))
 SLIP1 = ((N, 2), (1.5, 0.0))
@@ -102,12 +111,12 @@ def test_no_steady_state_without_softening_or_without_a_slip_everywhere():
     assert ex.steady_state(history(N, [MICRO] * 6), N) is None
     classified = ex.classify_increments(history(N, [SLIP1] * 6), N)
     assert not classified["steady"].any()
-    assert ex.slip_events(classified, N).empty
+    assert ex.steady_slips(classified, N).empty
 
 
 def test_slip_events_and_their_interfaces():
     classified = ex.classify_increments(history(N, EVENTS), N)
-    slips = ex.slip_events(classified, N)
+    slips = ex.steady_slips(classified, N)
     # steady state from increment 8: SLIP2, SLIP1, MULTI, MULTI, SLIP2, SLIP1, MULTI
     assert slips["increment"].tolist() == [8, 12, 14, 16, 18, 22, 24]
     assert slips["interfaces"].tolist() == ["2", "1", "1,2", "1,2", "2", "1", "1,2"]
@@ -136,7 +145,7 @@ def test_stress_drop_and_shear_since_the_previous_slip_of_the_same_interface():
 
 def test_rho_of_s():
     classified = ex.classify_increments(history(N, EVENTS), N)
-    slips = ex.slip_events(classified, N)
+    slips = ex.steady_slips(classified, N)
     np.testing.assert_allclose(ex.slip_fractions(slips, 2), [4 / 7, 3 / 7])
     np.testing.assert_allclose(ex.slip_fractions(slips, 3), [4 / 7, 3 / 7, 0])
     assert np.isnan(ex.slip_fractions(slips.iloc[:0], 2)).all()
@@ -144,7 +153,7 @@ def test_rho_of_s():
 
 def test_sequences_of_single_and_multi_slips():
     classified = ex.classify_increments(history(N, EVENTS), N)
-    sequences = ex.slip_sequences(ex.slip_events(classified, N))
+    sequences = ex.slip_sequences(ex.steady_slips(classified, N))
     # single, single | multi, multi | single, single | multi
     assert sequences["kind"].tolist() == ["single", "multi", "single", "multi"]
     assert sequences["length"].tolist() == [2, 2, 2, 1]
@@ -159,7 +168,7 @@ def test_sequences_of_single_and_multi_slips():
 
 def test_alternating_slips_form_no_sequence():
     events = [SLIP1, MULTI] * 4  # steady from the first multi-slip
-    sequences = ex.slip_sequences(ex.slip_events(ex.classify_increments(history(N, events), N), N))
+    sequences = ex.slip_sequences(ex.steady_slips(ex.classify_increments(history(N, events), N), N))
     assert (sequences["length"] == 1).all()
     assert ex.sequence_fractions(sequences) == {"single": 0, "multi": 0, "any": 0}
 
@@ -172,12 +181,3 @@ def test_bad_tables_are_refused_with_the_column_named():
         ex.classify_increments(table.drop(index=5), N)
     with pytest.raises(FileFormatError, match="S_a"):
         ex.interfaces_in(table[["increment", "gamma"]])
-
-
-def test_driving_regime_is_judged_at_the_paper_size():
-    assert ex.driving_regime(1e-3) == "stiff"
-    assert ex.driving_regime(1e-6) == "compliant"
-    assert ex.driving_regime(1e-3, 1458) == "stiff"
-    # plates M = N // 4 blocks thick: Phi ~ k h_p^2, so k = 1e-3 at N = 54 (M = 13) drives far more compliantly
-    assert ex.driving_regime(1e-3, 54) == "compliant"
-    assert ex.driving_regime(1e-3 * (364 / 13) ** 2, 54) == "stiff"

@@ -9,8 +9,8 @@ import pytest
 
 from stickslip import registry
 from stickslip.events.results import read_analysis_file
-from stickslip.fem.output import read_increments
 from stickslip.formats.event_table import read_slip_events
+from stickslip.formats.fem_run import read_increments
 from stickslip.lineage import Artifact
 from stickslip.params import parse_params
 
@@ -32,7 +32,7 @@ def fem_run(tmp_path_factory):
 def test_numerical_events_of_a_fem_run(fem_run, tmp_path):
     analysis = registry.get("analysis", "numerical-events")
     analysis.run(parse_params(analysis.params, {}), fem_run, tmp_path / "events.h5")
-    result = read_analysis_file(tmp_path / "events.h5", ("increments", "slips", "slip_interfaces"))
+    result = read_analysis_file(tmp_path / "events.h5", "event-table", ("increments", "slips", "slip_interfaces"))
     assert result.attrs["regime"] == "compliant" and result.attrs["n_interfaces"] == 2
     increments, slips, per = (result.tables[k] for k in ("increments", "slips", "slip_interfaces"))
     raw = read_increments(fem_run)
@@ -54,7 +54,7 @@ def test_front_dynamics_reruns_reproduce_the_stored_counts(fem_run, tmp_path):
     analysis = registry.get("analysis", "front-dynamics")
     params = parse_params(analysis.params, {"events": "slip", "interfaces": 0, "max_events": 3})
     analysis.run(params, fem_run, tmp_path / "fronts.h5")
-    result = read_analysis_file(tmp_path / "fronts.h5", ("failures", "fronts"))
+    result = read_analysis_file(tmp_path / "fronts.h5", "front-table", ("failures", "fronts"))
     failures, fronts = result.tables["failures"], result.tables["fronts"]
     raw = read_increments(fem_run).set_index("increment")
     assert len(fronts) == 3

@@ -8,9 +8,9 @@ from stickslip.events import extraction, plugin, results
 from stickslip.formats.event_table import read_slip_events
 from stickslip.h5io import FileFormatError
 from stickslip.hashing import sha256_file
-from test_events_extraction import EVENTS, N, history
+from test_events_extraction import EVENTS, N, history, run_attrs
 
-RUN_ATTRS = {"N": N, "plates": 3, "n_interfaces": 2, "k_drive": 1e-6, "seed": 4, "eps0": 5e-5, "c_s": 0.7071}
+RUN_ATTRS = run_attrs(N, 3, 1e-6, seed=4, eps0=5e-5, c_s=0.7071)
 STIFF = 1e-3 * (1458 / N) ** 2  # the paper's stiff driving, for N blocks
 
 
@@ -23,7 +23,7 @@ def write(path, events=EVENTS, attrs=RUN_ATTRS):
 
 def test_event_file_round_trip(tmp_path):
     tables = write(tmp_path / "events.h5")
-    read = results.read_analysis_file(tmp_path / "events.h5", tuple(tables))
+    read = results.read_analysis_file(tmp_path / "events.h5", "event-table", tuple(tables))
     assert read.n == 2 and read.regime == "compliant"
     assert read.attrs["N"] == N and read.attrs["seed"] == 4 and read.attrs["steady_state"] == 8
     assert read.attrs["analysis"] == "numerical-events"
@@ -61,22 +61,22 @@ def test_same_input_same_bytes(tmp_path):
 
 def test_run_without_steady_state_gives_empty_slip_tables(tmp_path):
     write(tmp_path / "e.h5", events=[((3, 0), (0.0, 0.0))] * 4)
-    read = results.read_analysis_file(tmp_path / "e.h5", ("slips", "sequences", "slip_interfaces"))
+    read = results.read_analysis_file(tmp_path / "e.h5", "event-table", ("slips", "sequences", "slip_interfaces"))
     assert read.attrs["steady_state"] == -1
     assert all(table.empty for table in read.tables.values())
 
 
 def test_missing_run_attributes_are_named():
     tables = plugin.event_tables(history(N, EVENTS), N)
-    with pytest.raises(FileFormatError, match="k_drive"):
-        plugin.event_attrs({"N": N, "plates": 3}, tables["increments"], source="run.h5")
+    with pytest.raises(FileFormatError, match="run.h5: run attributes lack phi, regime"):
+        plugin.event_attrs({"N": N, "plates": 3, "k_drive": 1e-3}, tables["increments"], source="run.h5")
 
 
 def test_grouping_by_regime_and_n(tmp_path):
     write(tmp_path / "c.h5")
-    write(tmp_path / "s.h5", attrs={**RUN_ATTRS, "k_drive": STIFF, "seed": 1})
-    write(tmp_path / "s2.h5", attrs={**RUN_ATTRS, "k_drive": STIFF, "seed": 0})
-    files = [results.read_analysis_file(tmp_path / f, ("slips",)) for f in ("s.h5", "c.h5", "s2.h5")]
+    write(tmp_path / "s.h5", attrs=run_attrs(N, 3, STIFF, seed=1))
+    write(tmp_path / "s2.h5", attrs=run_attrs(N, 3, STIFF, seed=0))
+    files = [results.read_analysis_file(tmp_path / f, "event-table", ("slips",)) for f in ("s.h5", "c.h5", "s2.h5")]
     groups = results.group_runs(files)
     assert list(groups) == [("compliant", 2), ("stiff", 2)]
     assert [f.attrs["seed"] for f in groups[("stiff", 2)]] == [0, 1]

@@ -14,7 +14,7 @@ import pytest
 
 from stickslip import registry
 from stickslip.events.thermal import ThermalEventParams
-from stickslip.fem.output import read_increments
+from stickslip.formats.fem_run import read_increments
 from stickslip.figures import figs_thermal
 from stickslip.figures.experimental_data import EVENTS
 from stickslip.h5io import open_file, read_table

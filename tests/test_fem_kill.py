@@ -17,7 +17,7 @@ import pytest
 
 from conftest import FEM_REFERENCE_CASE
 from stickslip.cli import main
-from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError, UnreadableFileError
 from stickslip.workflow_api import partial_path
 
@@ -82,16 +82,25 @@ def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(fem_reference_r
 
 def test_a_killed_workflow_job_resumes_to_the_same_bytes(fem_reference_run, tmp_path):
     output = tmp_path / "sim" / "fem" / "run.h5"
-    partial = partial_path(output)
-    for signum, increments in ((signal.SIGKILL, 100), (signal.SIGTERM, 220)):
+    partial, log = partial_path(output), output.with_suffix(".log")
+    for signum, increments in ((signal.SIGKILL, 100), (signal.SIGTERM, 220), (signal.SIGINT, 280)):
         status, _, _ = _kill_when_stored(_workflow_job(output), partial, increments, signum)
         assert status != 0
         assert not output.exists() and partial.exists()
-    assert "terminated by SIGTERM" in output.with_suffix(".log").read_text()
+        assert signum != signal.SIGTERM or "terminated by SIGTERM" in log.read_text()
+    assert "KeyboardInterrupt" in log.read_text()  # Ctrl-C (wrapped in a SystemError if it came in a kernel)
     done = subprocess.run(_workflow_job(output), capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    assert "resuming from" in output.with_suffix(".log").read_text()
-    assert output.read_bytes() == fem_reference_run.read_bytes() and not partial.exists()
+    assert "resuming from" in log.read_text()
+    assert output.read_bytes() == fem_reference_run.read_bytes() and os.path.samefile(partial, output)
+
+    # Snakemake stopped (Ctrl-C) while the job completed: it deletes the job's outputs and runs it again
+    output.unlink()
+    output.with_suffix(".json").unlink()
+    again = subprocess.run(_workflow_job(output), capture_output=True, text=True)
+    assert again.returncode == 0, again.stderr
+    assert "completed by an earlier job" in log.read_text() and "fem increments" not in log.read_text()
+    assert output.read_bytes() == fem_reference_run.read_bytes()
 
 
 def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(fem_reference_run, tmp_path, capsys):
@@ -107,10 +116,10 @@ def test_an_unreadable_file_is_moved_aside_and_the_run_starts_over(fem_reference
 
 
 def test_a_file_another_process_writes_is_refused(tmp_path):
-    from stickslip.h5io import writer_lock
+    from stickslip.output_safety.lock import writer_lock
 
     output = tmp_path / "run.h5"
-    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from stickslip.h5io import writer_lock\n"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from stickslip.output_safety.lock import writer_lock\n"
                                f"with writer_lock({str(output)!r}):\n print('locked', flush=True); time.sleep(60)"],
                               stdout=subprocess.PIPE, text=True)
     try:

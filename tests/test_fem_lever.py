@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from stickslip import registry
-from stickslip.fem.output import read_increments, read_run_attrs
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
 

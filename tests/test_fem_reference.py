@@ -11,8 +11,8 @@ import pytest
 from conftest import FEM_REFERENCE_CASE as REFERENCE_CASE
 from stickslip import registry
 from stickslip.cli import main
-from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.fem.replay import EventReplay
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError
 from stickslip.params import parse_params
 
@@ -100,12 +100,14 @@ def test_one_replay_serves_every_event_of_a_run(fem_reference_run):
 def _indices(path, increment):
     """Well index of Gauss point 0 of every block at ``increment - 1`` and ``increment``."""
     from stickslip.fem.backends import make_backend
-    from stickslip.fem.output import RunFile
+    from stickslip.fem.parameters import stored_params
     from stickslip.fem.system import System
+    from stickslip.formats.fem_run import RunFile
 
     with h5py.File(path) as file:
         run = RunFile(file)
-        system = System(run.params, run.mesh, make_backend(run.params.backend))
+        params = stored_params(file)
+        system = System(params, run.mesh, make_backend(params.backend))
         out = []
         for inc in (increment - 1, increment):
             system.restore(*run.state(inc))

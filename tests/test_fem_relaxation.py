@@ -8,12 +8,12 @@ import pandas as pd
 import pytest
 
 from stickslip import registry
-from stickslip.fem.dynamics import residual
 from stickslip.fem.backends import make_backend
+from stickslip.fem.dynamics import residual
 from stickslip.fem.forces import wells_hold
-from stickslip.fem.output import read_increments, read_run_attrs
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.system import System, derived_constants
+from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.params import parse_params
 

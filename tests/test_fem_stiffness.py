@@ -5,8 +5,8 @@ import math
 import pytest
 
 from stickslip import registry
-from stickslip.fem.output import describe, read_run_attrs
 from stickslip.fem.stiffness import PHI_STIFF, at_paper_phi, driving_regime, stiffness_ratio
+from stickslip.formats.fem_run import describe, read_run_attrs
 from stickslip.mesh.rows import plate_target_height
 from stickslip.params import parse_params
 
@@ -36,6 +36,9 @@ def test_phi_grows_as_the_square_of_the_plate_height_and_scales_with_the_modulus
     assert stiffness_ratio(1e-3 * (364 / 40) ** 2, 162) == pytest.approx(stiffness_ratio(1e-3, 1458))
     assert at_paper_phi(stiffness_ratio(1e-3 * (364 / 40) ** 2, 162))
     assert not at_paper_phi(1e-5) and not at_paper_phi(1e-2)
+    # plates M = N // 4 blocks thick: k = 1e-3 at N = 54 (M = 13) drives far more compliantly than at N = 1458
+    assert driving_regime(stiffness_ratio(1e-3, 54)) == "compliant"
+    assert driving_regime(stiffness_ratio(1e-3 * (364 / 13) ** 2, 54)) == "stiff"
 
 
 def test_the_run_file_states_phi_and_regime(tmp_path):

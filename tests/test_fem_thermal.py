@@ -24,7 +24,7 @@ import pytest
 from scipy import special, stats
 
 from stickslip.fem.laws import Cusp, Smooth, backward_barrier, forward_barrier
-from stickslip.fem.output import RunFile, read_increments, read_run_attrs
+from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.thermal import (BACKWARD, FORWARD, HOP, NONE, THRESHOLD, barrier_bounds, block_barrier,
                                    hop_step, sample_event)

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from stickslip import registry
-from stickslip.fem.output import read_run_attrs
 from stickslip.fem.yield_strains import HeldYieldStrains, interface_initstate, narrowest_well, yield_strains
+from stickslip.formats.fem_run import read_run_attrs
 from stickslip.h5io import read_table
-from stickslip.params import parse_params
+from stickslip.params import describe, parse_params
 
 
 def test_slid_and_widened_windows_hold_the_values_of_the_long_sequence():
@@ -48,10 +48,24 @@ def test_a_run_holding_few_wells_is_bit_identical_to_one_holding_many(tmp_path):
 
 
 @pytest.mark.slow
-def test_the_margin_stop_remains_for_the_paper_runs(tmp_path):
+def test_the_margin_stop_remains_for_the_paper_runs_and_is_the_default_bound(tmp_path):
+    """max_increments 0 stops where the paper's code stops, with or without unbounded yield strains."""
     _run(tmp_path / "stop.h5", yield_strains="stop", nchunk=30, max_increments=0)
     attrs = read_run_attrs(tmp_path / "stop.h5")
     assert attrs["completed"] and attrs["stop_reason"] == "margin"
     with h5py.File(tmp_path / "stop.h5") as file:
         hops = read_table(file, "increments")["S_a1"].to_numpy()
     assert hops.sum() <= 9 * (30 - 5)  # no block went past its last 5 wells
+    _run(tmp_path / "extend.h5", nchunk=30, max_increments=0)  # the defaults: yield_strains 'extend'
+    assert read_run_attrs(tmp_path / "extend.h5")["stop_reason"] == "margin"
+    with h5py.File(tmp_path / "stop.h5") as stop, h5py.File(tmp_path / "extend.h5") as extend:
+        assert read_table(extend, "increments").equals(read_table(stop, "increments"))
+        for name in ("state/u", "state/target", "state/t", "event/delta_u", "event/delta_eps"):
+            np.testing.assert_array_equal(extend[name][...], stop[name][...], err_msg=name)
+
+
+def test_the_default_parameters_are_valid_and_say_what_they_do():
+    params = parse_params(registry.get("solver", "fem").params, {})  # `stickslip simulate --solver fem -o run.h5`
+    assert (params.yield_strains, params.max_increments) == ("extend", 0)
+    doc = {name: text for name, _, _, _, text in describe(type(params))}["max_increments"]
+    assert "0: stop where the paper's code does" in doc and "nchunk" in doc

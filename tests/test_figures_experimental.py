@@ -89,11 +89,16 @@ def test_every_figure_is_drawn_reproducibly(study, tmp_path, name):
 
 
 def test_inputs_without_run_attributes_are_refused(tmp_path):
+    from stickslip.formats import stamp
     from stickslip.h5io import open_file, write_table
 
     path = tmp_path / "other.h5"
     with open_file(path, "w") as f:
         write_table(f, "slips", pd.DataFrame({"a": [1]}))
+    with pytest.raises(FileFormatError, match="no 'format' attribute"):
+        experimental_data.load_slips([path])
+    with open_file(path, "r+") as f:
+        stamp(f, "event-table")
     with pytest.raises(FileFormatError, match="attribute 'n' is missing"):
         experimental_data.load_slips([path])
 

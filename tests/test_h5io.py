@@ -7,7 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stickslip.h5io import FileFormatError, atomic_output, open_file, read_table, write_dataset, write_table
+from stickslip.h5io import FileFormatError, open_file, read_table, write_dataset, write_table
+from stickslip.output_safety.atomic import atomic_output
 
 
 def _write(path, table):

@@ -1,10 +1,11 @@
-"""Figure plugin 'figS-mesh': picks the requested mesh among its inputs, writes PDF and PNG."""
+"""Figure plugin 'figS-mesh': picks the requested mesh among its inputs and draws every element of it."""
 
+import numpy as np
 import pytest
 
 from stickslip import registry
 from stickslip.h5io import FileFormatError
-from stickslip.mesh import MeshParams, write_mesh
+from stickslip.mesh import MeshParams, read_mesh, write_mesh
 from stickslip.params import parse_params
 
 
@@ -28,10 +29,16 @@ def test_selects_the_mesh_by_plates_and_N(meshes):
         select_mesh(everything, MeshFigureParams(plates=4))
 
 
-def test_plugin_writes_pdf_and_png(meshes, tmp_path):
+def test_plugin_draws_every_element_of_the_chosen_mesh(meshes, tmp_path, drawn_figures):
     plugin = registry.get("figure", "figS-mesh")
     assert plugin.inputs == ("format:mesh",)
     params = parse_params(plugin.params, {"plates": 3, "zoom_width": 20})
     output = tmp_path / "figS-mesh.pdf"
     plugin.run(params, {"format:mesh": list(meshes.values())}, output)
-    assert output.stat().st_size > 0 and output.with_suffix(".png").stat().st_size > 0
+    assert output.is_file() and output.with_suffix(".png").is_file()
+    mesh = read_mesh(meshes[(81, 3)])  # plates = 3: the largest N
+    full, zoom = drawn_figures[0].axes
+    elements = full.collections[0]
+    assert len(elements.get_paths()) == mesh.nelem
+    np.testing.assert_allclose(elements.get_paths()[0].vertices[:4], mesh.coor[mesh.conn[0]])
+    assert zoom.get_xlim() == pytest.approx((0.0, 20 * mesh.h))

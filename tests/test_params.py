@@ -29,7 +29,8 @@ def test_defaults_and_conversion_from_strings():
 
 
 @pytest.mark.parametrize("values, words", [
-    ({"Nx": 3}, ["'Nx'", "allowed: N, k_drive, drive, creep, B"]),
+    ({"Nx": 3}, ["'Nx'", "allowed: N, k_drive, drive, creep, B", "(did you mean 'N'?)"]),
+    ({"k_drvie": 1.0}, ["unknown parameter 'k_drvie' (did you mean 'k_drive'?); allowed: N, k_drive"]),
     ({"N": "nine"}, ["'N'", "integer", "'nine'"]),
     ({"N": 2.5}, ["'N'", "integer"]),
     ({"N": 0}, ["'N'", ">= 1"]),

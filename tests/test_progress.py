@@ -15,7 +15,7 @@ import pytest
 
 from stickslip import progress, registry
 from stickslip.events.extraction import classify_increments
-from stickslip.fem.output import read_increments
+from stickslip.formats.fem_run import read_increments
 from stickslip.params import parse_params
 
 from conftest import python_path
@@ -124,3 +124,12 @@ def test_simulate_shows_a_bar_on_a_terminal(tmp_path):
     os.close(leader)
     assert result.returncode == 0
     assert b"\r" in shown and re.search(rb"virtual experiment: 100%\|#*\| 600/600", shown.replace(b"\xe2\x96\x88", b"#"))
+
+
+def test_an_early_error_prints_the_progress_line_once(tmp_path, capsys):
+    from stickslip.cli import main
+
+    assert main(["analyze-experiment", str(tmp_path / "absent.h5"), "-o", str(tmp_path / "slips.csv")]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == ["analyze-experiment: 0/1 run (0%) [00:00 elapsed, ? left, ? run/s]",
+                   f"stickslip: error: {tmp_path / 'absent.h5'}: no such file"]

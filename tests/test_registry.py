@@ -100,3 +100,19 @@ def test_a_job_given_its_plugin_module_imports_only_that_module():
     assert _imports_after("from stickslip import registry; registry.get('solver', 'lever')") == everything
     wrong = "from stickslip import registry; p = registry.get('solver', 'lever', 'stickslip.experiment.aging')"
     assert _imports_after(wrong + "; assert p.name == 'lever'") == everything
+
+
+def test_plugins_command_lists_every_format_with_its_reader(toy_plugins, capsys):
+    from stickslip.cli import main
+
+    assert main(["plugins", "--kind", "format"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "formats:"
+    listed = {line.split()[0]: line.strip() for line in lines[1:]}
+    # the built-in formats and the one an entry-point package registers, each with its module
+    assert set(listed) == {"mesh", "fem-run", "timeseries", "event-table", "front-table", "toy-block"}
+    assert listed["fem-run"].startswith("fem-run 1 ") and listed["fem-run"].endswith("(stickslip.formats.fem_run)")
+    assert "[numerical]" in listed["fem-run"] and "[experimental]" in listed["timeseries"]
+    assert listed["toy-block"].endswith("(stickslip_toy)")
+    assert main(["plugins", "--kind", "solver"]) == 0
+    assert "formats:" not in capsys.readouterr().out

@@ -12,7 +12,7 @@ import sqlite3
 import pytest
 
 from conftest import copy_workflow
-from stickslip.fem.output import read_run_attrs
+from stickslip.formats.fem_run import read_run_attrs
 from stickslip.provenance.record import read_record
 from test_workflow import snakemake
 

@@ -140,3 +140,58 @@ def test_reader_rejects_missing_and_non_hdf5_files(tmp_path):
 def test_extra_items_cannot_overwrite_the_format(tmp_path):
     with pytest.raises(ValueError, match="must not reuse the format's names: n"):
         write_timeseries(tmp_path / "run.h5", make_record(), attrs={"n": 5})
+
+
+#: The items of a recording in shared/design.md ("Experimental time-series format"), the layout a lab script writes.
+DOCUMENTED_ATTRS = ("n", "n_slabs", "protocol", "a", "normal_force", "k_spring", "h", "H", "V")
+
+
+def _lab_file(path, record, **units):
+    """A lab script's file: the documented layout only, written by plain h5py (no stickslip attribute)."""
+    with h5py.File(path, "w") as f:
+        for name in ("t_F", "F", "t_x", "x"):
+            f[name] = getattr(record, name)
+            if name in units:
+                f[name].attrs["unit"] = units[name]
+        for name in DOCUMENTED_ATTRS:
+            f.attrs[name] = getattr(record, name)
+
+
+def test_a_lab_file_in_the_documented_layout_is_read_as_version_1(tmp_path, capsys):
+    from stickslip.cli import main
+    from stickslip.experiment.virtual.model import simulate
+    from stickslip.solvers.lever import LeverParams
+
+    signals, _, _ = simulate(LeverParams(n=2, duration=600.0, seed=1))
+    ours, lab = tmp_path / "stickslip.h5", tmp_path / "lab.h5"
+    write_timeseries(ours, signals)
+    _lab_file(lab, signals, t_F="s", x="mm")  # a unit attribute, where present, is the documented one
+    capsys.readouterr()
+    back = read_timeseries(lab)
+    assert capsys.readouterr().err == (f"stickslip: note: {lab}: no 'format' attribute; read as a lab recording in "
+                                       f"the documented layout (timeseries version 1), checked by its content\n")
+    for field in dataclasses.fields(ExperimentRecord):
+        np.testing.assert_array_equal(getattr(back, field.name), getattr(signals, field.name))
+    for path in (ours, lab):
+        assert main(["analyze-experiment", str(path), "-o", str(path.with_suffix(".csv"))]) == 0
+    slips = [pd.read_csv(path.with_suffix(".csv")).drop(columns="run") for path in (ours, lab)]
+    assert len(slips[0]) > 0
+    pd.testing.assert_frame_equal(slips[0], slips[1])
+
+
+LAB_FILE_FAULTS = [
+    (lambda f: f["x"].attrs.__setitem__("unit", "m"), "'x' is in [m]; the format stores it in [mm]"),
+    (lambda f: f.__delitem__("t_x"), "'t_x' is missing (required dataset) (a file without a 'format' attribute is "
+                                     "read as a lab recording in the documented layout"),
+    (lambda f: f["t_F"].__setitem__(3, 0.0), "'t_F' must be strictly increasing"),
+    (lambda f: f.attrs.__setitem__("format", "fem-run"), "a fem-run file version -1, expected timeseries version 1"),
+]
+
+
+@pytest.mark.parametrize("edit, message", LAB_FILE_FAULTS)
+def test_a_lab_file_is_checked_by_its_content(tmp_path, edit, message):
+    _lab_file(tmp_path / "lab.h5", make_record())
+    with h5py.File(tmp_path / "lab.h5", "r+") as f:
+        edit(f)
+    with pytest.raises(FileFormatError, match=re.escape(message)):
+        read_timeseries(tmp_path / "lab.h5")

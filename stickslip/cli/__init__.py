@@ -3,7 +3,8 @@
 Each module in :data:`COMMANDS` defines ``add_parser(subparsers)``, which adds its
 sub-command and sets ``func(args) -> int`` as the parser default. Errors of the
 user's making (bad parameter, unknown plugin, unreadable file) are printed as one
-line ``stickslip: error: ...`` with exit status 2, never as a traceback. Ctrl-C and
+line ``stickslip: error: ...`` with exit status 2, never as a traceback. Every command that writes a
+file refuses an existing output that holds another run unless given ``--overwrite``. Ctrl-C and
 SIGTERM end a command cleanly (files closed, what a run stored is kept) with exit
 status 130 (SIGINT) or 143 (SIGTERM).
 """
@@ -12,17 +13,26 @@ import argparse
 import importlib
 import sys
 
-from ..h5io import FileFormatError, OutputError
+from ..h5io import FileFormatError
+from ..output_safety.errors import OutputError
 from ..params import ParameterError
 from ..registry import PluginError
-from ..termination import exit_status, interruption, sigterm_as_interrupt
+from ..termination import exit_status, interrupts_raised, interruption
 
-__all__ = ["main", "COMMANDS"]
+__all__ = ["main", "COMMANDS", "add_overwrite_option"]
 
 #: Sub-command modules, in the order of ``stickslip --help``.
 COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db")
 
 USER_ERRORS = (ParameterError, PluginError, FileFormatError, OutputError)
+
+
+def add_overwrite_option(parser):
+    """Add ``--overwrite`` to a command that writes a file: without it, an existing output that holds another
+    run is refused (:mod:`stickslip.output_safety.overwrite`)."""
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing output that holds another run (kept aside until the new one is "
+                             "complete)")
 
 
 def build_parser():
@@ -42,7 +52,7 @@ def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with sigterm_as_interrupt():
+        with interrupts_raised():
             return args.func(args) or 0
     except USER_ERRORS as error:
         print(f"stickslip: error: {error}", file=sys.stderr)

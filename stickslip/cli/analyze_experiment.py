@@ -1,14 +1,23 @@
-"""``stickslip analyze-experiment``: slips of experimental recordings to CSV, and the aging fit."""
+"""``stickslip analyze-experiment``: slips of experimental recordings to CSV, and the aging fit.
 
+A record implausible for the apparatus it claims (:mod:`stickslip.experiment.plausibility`: a unit
+mistake) gets a one-line warning; if no slip is found at all, the command then fails (exit 2) instead
+of writing an empty result.
+"""
+
+import sys
 from pathlib import Path
 
 import pandas as pd
 
 from ..experiment.aging import FITS, fit_aging, fit_aging_per_interface
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
+from ..experiment.plausibility import no_slip_warning, travel_warning
 from ..experiment.timeseries import read_timeseries
+from ..output_safety.overwrite import write_text_output
 from ..params import ParameterError, parse_assignments, parse_params
 from ..progress import iterate
+from . import add_overwrite_option
 
 
 def add_parser(subparsers):
@@ -21,7 +30,9 @@ def add_parser(subparsers):
                     "slips with a waiting time: through the origin (the paper's fit) or with a free intercept c "
                     "(dmu = c + B ln(T/T0)), over all interfaces or per interface.")
     parser.add_argument("runs", nargs="+", type=Path, metavar="RUN.h5", help="time-series files")
-    parser.add_argument("-o", "--output", type=Path, help="CSV file of the slips")
+    parser.add_argument("-o", "--output", type=Path,
+                        help="CSV file of the slips (an existing one with other content is refused)")
+    add_overwrite_option(parser)
     parser.add_argument("--aging", action="store_true",
                         help="fit the aging law; the last line printed is `B=<value> +- <error>` (origin) or "
                              "`B=<value> +- <error> c=<value> +- <error>` (intercept)")
@@ -42,14 +53,21 @@ def run(args):
         raise ParameterError("nothing to do: give -o EVENTS.csv and/or --aging")
     params = parse_params(ExperimentEventsParams, parse_assignments(args.param),
                           owner="analysis 'experiment-events'")
-    tables = []
+    tables, warnings = [], []
     for path in iterate(args.runs, desc="analyze-experiment", unit="run"):
-        slips, _ = analyse_record(read_timeseries(path), params)
+        record = read_timeseries(path)
+        slips, _ = analyse_record(record, params)
         tables.append(slips.assign(run=str(path)))
+        found = (travel_warning(record, str(path)), no_slip_warning(record, len(slips), str(path)))
+        warnings += [line for line in found if line]
+    for line in warnings:
+        print(f"stickslip: warning: {line}", file=sys.stderr)
     slips = pd.concat(tables, ignore_index=True)
+    if warnings and slips.empty:
+        raise ParameterError("no slip found, and the records are implausible for their apparatus (warnings above); "
+                             "nothing written")
     if args.output is not None:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        slips.to_csv(args.output, index=False)
+        write_text_output(args.output, slips.to_csv(index=False), overwrite=args.overwrite)
         print(f"{len(slips)} slips ({int(slips['multi'].sum())} in multi-interface events) -> {args.output}")
     if args.aging:
         single = slips[~slips["multi"].to_numpy(dtype=bool)]
@@ -62,7 +80,8 @@ def run(args):
             try:
                 fit = fit_aging(single["T"], single["dmu"], t0=params.t0, fit=args.fit)
             except ValueError as error:
-                raise ParameterError(f"aging fit: {error}") from None
+                hint = "; the records are implausible for their apparatus (warnings above)" if warnings else ""
+                raise ParameterError(f"{error}{hint}") from None
             print(f"{fit.n_slips} slips in {len(fit.bins)} bins")
             print(_fit_line(fit, intercept=args.fit == "intercept"))
     return 0

@@ -1,9 +1,17 @@
-"""``stickslip import-csv``: convert a lab export (force CSV + positions CSV) into a time-series file."""
+"""``stickslip import-csv``: convert a lab export (force CSV + positions CSV) into a time-series file.
+
+A record implausible for the apparatus it claims (a unit mistake, :mod:`stickslip.experiment.plausibility`)
+is written, with a one-line warning.
+"""
 
 from pathlib import Path
 
+import sys
+
 from ..experiment.csv_import import UNITS, import_csv
+from ..experiment.plausibility import travel_warning
 from ..experiment.timeseries import PROTOCOLS
+from . import add_overwrite_option
 
 
 def add_parser(subparsers):
@@ -17,6 +25,7 @@ def add_parser(subparsers):
     parser.add_argument("--positions", required=True, type=Path, metavar="POSITIONS.csv",
                         help="slab positions CSV file")
     parser.add_argument("-o", "--output", required=True, type=Path, help="output file (HDF5)")
+    add_overwrite_option(parser)
     parser.add_argument("--n", required=True, type=int, help="driven slabs (1 for the individual protocol)")
     parser.add_argument("--n-slabs", type=int, default=5, help="slabs in the stack (default 5)")
     parser.add_argument("--protocol", choices=PROTOCOLS, default="stack", help="driving protocol (default stack)")
@@ -39,6 +48,9 @@ def run(args):
     record = import_csv(args.force, args.positions, args.output, n=args.n, n_slabs=args.n_slabs,
                         protocol=args.protocol, a=args.a, normal_force=args.normal_force, k_spring=args.k_spring,
                         h=args.h, H=args.H, V=args.V, time_unit=args.time_unit, force_unit=args.force_unit,
-                        position_unit=args.position_unit)
+                        position_unit=args.position_unit, overwrite=args.overwrite)
     print(f"{args.output}: {record.t_F.size} force samples, {record.t_x.size} frames of {record.n_slabs} slabs")
+    warning = travel_warning(record, str(args.output))
+    if warning:
+        print(f"stickslip: warning: {warning}", file=sys.stderr)
     return 0

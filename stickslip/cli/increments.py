@@ -2,7 +2,9 @@
 
 from pathlib import Path
 
-from ..fem.output import read_increments
+from ..formats.fem_run import read_increments
+from ..output_safety.overwrite import write_text_output
+from . import add_overwrite_option
 
 
 def add_parser(subparsers):
@@ -14,14 +16,15 @@ def add_parser(subparsers):
                     "epsd_l, sigd_l, ubar_l, fxdrive_l (target_x - ubar_x; 0 without spring), per interface a "
                     "S_a<a>, A_a<a>.")
     parser.add_argument("run", type=Path, help="fem simulation file (HDF5)")
-    parser.add_argument("-o", "--output", required=True, type=Path, help="output table (CSV)")
+    parser.add_argument("-o", "--output", required=True, type=Path,
+                        help="output table (CSV; an existing one with other content is refused)")
+    add_overwrite_option(parser)
     parser.set_defaults(func=run)
 
 
 def run(args):
     """Read the observables and write the CSV."""
     table = read_increments(args.run)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    table.to_csv(args.output, index=False, float_format="%.17g")
+    write_text_output(args.output, table.to_csv(index=False, float_format="%.17g"), overwrite=args.overwrite)
     print(f"{args.output}: {len(table)} increments, {len(table.columns)} columns")
     return 0

@@ -1,6 +1,6 @@
-"""``stickslip plugins``: list the registered solvers, analyses and figures, with their contracts."""
+"""``stickslip plugins``: list the registered solvers, analyses and figures, with their contracts, and the formats."""
 
-from .. import registry
+from .. import formats, registry
 from ..params import describe
 
 PLURAL = {"solver": "solvers", "analysis": "analyses", "figure": "figures"}
@@ -9,15 +9,16 @@ PLURAL = {"solver": "solvers", "analysis": "analyses", "figure": "figures"}
 def add_parser(subparsers):
     """Add the ``plugins`` sub-command."""
     parser = subparsers.add_parser("plugins", help="list the plugins",
-                                   description="List every registered plugin by kind, with its version.")
-    parser.add_argument("--kind", choices=registry.KINDS, help="only this kind")
+                                   description="List every registered plugin by kind, with its version, then every "
+                                               "artifact format (name, version, source, reader/writer module).")
+    parser.add_argument("--kind", choices=(*registry.KINDS, "format"), help="only this kind (or only the formats)")
     parser.add_argument("--params", action="store_true", help="also list each plugin's parameters")
     parser.set_defaults(func=run)
 
 
 def run(args):
-    """Print the plugins (and their parameters with --params)."""
-    for kind in [args.kind] if args.kind else registry.KINDS:
+    """Print the plugins (and their parameters with --params), then the formats."""
+    for kind in registry.KINDS if args.kind is None else [kind for kind in registry.KINDS if kind == args.kind]:
         print(f"{PLURAL[kind]}:")
         for name, plugin in registry.available(kind).items():
             contract = ([f"consumes {', '.join(plugin.consumes)}"] if plugin.consumes else [])
@@ -30,4 +31,10 @@ def run(args):
                 for pname, ptype, default, unit, doc in describe(plugin.params):
                     unit = f" [{unit}]" if unit else ""
                     print(f"      {pname} ({ptype}, default {default!r}){unit}: {doc}")
+    if args.kind in (None, "format"):
+        registry.available("solver")  # loads every plugin, and with them the formats they register
+        print("formats:")
+        for name, fmt in formats.available_formats().items():
+            source = f" [{fmt.source}]" if fmt.source else ""
+            print(f"  {name} {fmt.version}  {fmt.summary}{source}  ({fmt.module})")
     return 0

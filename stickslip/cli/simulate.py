@@ -4,9 +4,11 @@ import argparse
 from pathlib import Path
 
 from .. import registry
-from ..h5io import check_output
 from ..numba_options import set_num_threads
-from ..params import parse_assignments, parse_params
+from ..output_safety.atomic import check_output
+from ..output_safety.overwrite import claimed_output
+from ..params import params_to_dict, parse_assignments, parse_params
+from . import add_overwrite_option
 
 
 def add_parser(subparsers):
@@ -19,8 +21,12 @@ def add_parser(subparsers):
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                         help="one parameter (repeat); the others keep their defaults")
     parser.add_argument("--threads", type=positive_int, default=1, help="threads for parallel kernels (default 1)")
-    parser.add_argument("-o", "--output", required=True, type=Path, help="output file (HDF5)")
+    parser.add_argument("-o", "--output", required=True, type=Path,
+                        help="output file (HDF5); an existing one of the same run is resumed (fem) or written "
+                             "again, one of another run is refused")
+    add_overwrite_option(parser)
     parser.set_defaults(func=run)
+
 
 
 def positive_int(text):
@@ -34,11 +40,18 @@ def positive_int(text):
     return value
 
 
+def run_identity(plugin, params):
+    """What a solver's output file stores about its run (root attributes): format, solver, version, parameters."""
+    return {"format": plugin.produces, "solver": plugin.name, "solver_version": plugin.version,
+            "params": params_to_dict(params)}
+
+
 def run(args):
-    """Validate the parameters, then run the solver."""
+    """Validate the parameters and the output, then run the solver."""
     plugin = registry.get("solver", args.solver)
     params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
     threads = set_num_threads(args.threads)
     check_output(args.output)
-    plugin.run(params, args.output, threads=threads, inputs={})
+    with claimed_output(args.output, run_identity(plugin, params), overwrite=args.overwrite):
+        plugin.run(params, args.output, threads=threads, inputs={})
     return 0

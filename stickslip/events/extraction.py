@@ -24,18 +24,14 @@ import re
 import numpy as np
 import pandas as pd
 
-from ..fem.stiffness import PAPER_N, stiffness_ratio
-from ..fem.stiffness import driving_regime as regime_of
 from ..h5io import FileFormatError
 from ..mesh.layered import interface_layer
 
 __all__ = [
-    "PAPER_N",
-    "driving_regime",
     "interfaces_in",
     "steady_state",
     "classify_increments",
-    "slip_events",
+    "steady_slips",
     "slip_interfaces",
     "slip_fractions",
     "slip_sequences",
@@ -47,27 +43,6 @@ __all__ = [
 TANGENT_FRACTION = 0.95
 
 _S_COLUMN = re.compile(r"^S_a(\d+)$")
-
-
-def driving_regime(k_drive, N=PAPER_N, G=1.0):
-    """``"stiff"`` or ``"compliant"`` driving, from the rigidity ratio Phi of the run.
-
-    Parameters
-    ----------
-    k_drive : float
-        Drive spring stiffness per unit volume [FE units].
-    N : int, optional
-        Blocks per interface (default: the paper's 1458).
-    G : float, optional
-        The solver's modulus ``G = 2 mu``.
-
-    Returns
-    -------
-    str
-        :func:`stickslip.fem.stiffness.driving_regime` of
-        :func:`stickslip.fem.stiffness.stiffness_ratio`.
-    """
-    return regime_of(stiffness_ratio(k_drive, N, G))
 
 
 def interfaces_in(increments):
@@ -154,7 +129,7 @@ def classify_increments(increments, N, *, source="increment table"):
     Parameters
     ----------
     increments : pandas.DataFrame
-        The solver's increment table (see :func:`stickslip.fem.output.read_increments`):
+        The solver's increment table (see :func:`stickslip.formats.fem_run.read_increments`):
         ``increment``, ``kick``, ``gamma`` [gamma0], ``epsd`` [eps0], ``sigd`` [sig0], per
         interface ``S_a<a>``, ``A_a<a>`` and per layer ``sigd_<l>`` [sig0], consecutive
         increments from 0.
@@ -196,7 +171,7 @@ def _slip_rows(classified):
     return classified["kind"].isin(("single", "multi")).to_numpy() & classified["steady"].to_numpy(dtype=bool)
 
 
-def slip_events(classified, N):
+def steady_slips(classified, N):
     """Return the slip events of the steady state, one row each.
 
     Parameters
@@ -274,7 +249,7 @@ def slip_fractions(slips, n):
     Parameters
     ----------
     slips : pandas.DataFrame
-        Slip events (column ``s``), e.g. of :func:`slip_events`; several runs may be
+        Slip events (column ``s``), e.g. of :func:`steady_slips`; several runs may be
         concatenated.
     n : int
         Number of interfaces.

@@ -27,9 +27,11 @@ import pandas as pd
 
 from .. import h5io, registry
 from ..formats.analysis_file import write_analysis_file
+from ..formats.fem_run import RunFile, read_increments, read_run_attrs
+from ..formats.front_table import FAILURE_DTYPES, FORMAT, FRONT_DTYPES
 from ..h5io import FileFormatError
 from ..lineage import Artifact
-from ..mesh import interface_layer, load_mesh
+from ..mesh import interface_layer
 from ..params import ParameterError, param
 from ..progress import iterate
 from ..registry import register
@@ -42,14 +44,8 @@ __all__ = ["FrontParams", "VERSION", "slipping_interfaces", "front_fit", "analys
 NAME = "front-dynamics"
 VERSION = "1"
 
+#: Columns of a replay's failure table (:meth:`stickslip.fem.replay.EventReplay.failures`).
 FAILURE_COLUMNS = ("a", "block", "t", "direction")
-
-#: Columns of the output table "failures" (one row per block failure) and their types.
-FAILURE_DTYPES = {"increment": "int64", "a": "int64", "block": "int64", "t": "float64", "direction": "int64"}
-
-#: Columns of the output table "fronts" (one row per re-run event), see :func:`analyse_event`.
-FRONT_DTYPES = {"increment": "int64", "s": "int64", "a_first": "int64", "a_second": "int64", "nucleation": "int64",
-                "c_f": "float64", "fit_t0": "float64", "fit_points": "int64", "t_first": "float64", "tau": "float64"}
 
 
 def _check_failures(failures, source):
@@ -275,7 +271,7 @@ def write_front_file(failures, fronts, attrs, output, *, input, params=FrontPara
         The analysed run file (its checksum goes into the header).
     params : FrontParams, optional
     """
-    write_analysis_file(output, "front-table", analysis=NAME, version=VERSION, params=params, input=input,
+    write_analysis_file(output, FORMAT, analysis=NAME, version=VERSION, params=params, input=input,
                         attrs=attrs, tables={"failures": failures, "fronts": fronts})
 
 
@@ -293,16 +289,11 @@ def solver_replay(input, analysis=NAME):
 @register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
-    from ..fem.output import read_increments, read_run_attrs
-
     replay = solver_replay(input)
     run_attrs = read_run_attrs(input)
-    for key in ("N", "h", "c_s"):
-        if key not in run_attrs:
-            raise FileFormatError(f"{input}: run attributes lack {key}")
     N = int(run_attrs["N"])
     with h5io.open_file(input) as file:
-        heights = load_mesh(file["mesh"]).layer_mid_height
+        heights = RunFile(file).mesh.layer_mid_height
     spacing = interface_spacing([heights[interface_layer(a)] for a in range(1, int(run_attrs["n_interfaces"]) + 1)])
     classified = extraction.classify_increments(read_increments(input), N, source=str(input))
     failures, fronts = front_tables(classified, replay.failures, N=N, h=float(run_attrs["h"]),

@@ -9,32 +9,31 @@ tables as in :func:`stickslip.h5io.write_table`):
 ``increments``
     every stored increment, classified (:func:`~stickslip.events.extraction.classify_increments`);
 ``slips``
-    one row per steady-state slip event (:func:`~stickslip.events.extraction.slip_events`);
+    one row per steady-state slip event (:func:`~stickslip.events.extraction.steady_slips`);
 ``slip_interfaces``
     one row per (slip event, slipping interface) (:func:`~stickslip.events.extraction.slip_interfaces`);
 ``sequences``
     runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`).
 
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
-plus ``phi`` (the rigidity ratio Phi, :func:`~stickslip.fem.stiffness.stiffness_ratio`),
-``regime`` ("stiff" or "compliant", from ``phi``), ``steady_state`` (first steady-state increment,
+with the run's ``phi`` (the rigidity ratio Phi) and ``regime`` ("stiff" or "compliant") as the run file
+states them, ``steady_state`` (first steady-state increment,
 -1 if not reached) and the analysis header.
 """
 
 import dataclasses
-import json
 
 import numpy as np
 import pandas as pd
 
-from ..fem.stiffness import driving_regime, stiffness_ratio
 from ..formats.analysis_file import write_analysis_file
 from ..formats.event_table import slip_events_table
+from ..formats.fem_run import read_increments, read_run_attrs
 from ..h5io import FileFormatError
 from ..registry import register
 from . import extraction
 
-__all__ = ["EventParams", "NAME", "VERSION", "event_tables", "slip_events", "event_attrs", "write_event_file", "run"]
+__all__ = ["EventParams", "NAME", "VERSION", "event_tables", "numerical_slip_events", "event_attrs", "write_event_file", "run"]
 
 NAME = "numerical-events"
 VERSION = "1"
@@ -51,7 +50,7 @@ def event_tables(increments, N, *, source="increment table"):
     Parameters
     ----------
     increments : pandas.DataFrame
-        The solver's increment table (see :func:`stickslip.fem.output.read_increments`).
+        The solver's increment table (see :func:`stickslip.formats.fem_run.read_increments`).
     N : int
         Blocks per interface.
     source : str, optional
@@ -63,18 +62,18 @@ def event_tables(increments, N, *, source="increment table"):
         ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``.
     """
     classified = extraction.classify_increments(increments, N, source=source)
-    slips = extraction.slip_events(classified, N)
+    slips = extraction.steady_slips(classified, N)
     per_interface = extraction.slip_interfaces(classified, N)
     return {
         "increments": classified,
         "slips": slips,
         "slip_interfaces": per_interface,
         "sequences": extraction.slip_sequences(slips),
-        "slip_events": slip_events(per_interface),
+        "slip_events": numerical_slip_events(per_interface),
     }
 
 
-def slip_events(per_interface):
+def numerical_slip_events(per_interface):
     """The normalised slip table (format ``event-table``) of a run's ``slip_interfaces`` table.
 
     Parameters
@@ -96,13 +95,13 @@ def slip_events(per_interface):
 
 
 def event_attrs(run_attrs, classified, *, source="run"):
-    """Return the attributes of an event file: the run's, plus regime and steady state.
+    """Return the attributes of an event file: the run's (with its ``phi`` and ``regime``), plus the steady state.
 
     Parameters
     ----------
     run_attrs : Mapping[str, object]
-        Attributes of the run (see :func:`stickslip.fem.output.read_run_attrs`); must
-        hold ``N``, ``plates`` and ``k_drive``.
+        Attributes of the run (see :func:`stickslip.formats.fem_run.read_run_attrs`); must
+        hold ``N``, ``plates``, ``phi`` and ``regime``.
     classified : pandas.DataFrame
         Output of :func:`~stickslip.events.extraction.classify_increments`.
     source : str, optional
@@ -112,15 +111,11 @@ def event_attrs(run_attrs, classified, *, source="run"):
     -------
     dict[str, object]
     """
-    missing = [key for key in ("N", "plates", "k_drive") if key not in run_attrs]
+    missing = [key for key in ("N", "plates", "phi", "regime") if key not in run_attrs]
     if missing:
         raise FileFormatError(f"{source}: run attributes lack {', '.join(missing)}")
     attrs = dict(run_attrs)
     attrs["n_interfaces"] = int(run_attrs["plates"]) - 1
-    params = run_attrs.get("params", {})
-    G = (json.loads(params) if isinstance(params, str) else params).get("G", 1.0)
-    attrs["phi"] = stiffness_ratio(run_attrs["k_drive"], run_attrs["N"], G)
-    attrs["regime"] = driving_regime(attrs["phi"])
     steady = classified["increment"][classified["steady"]]
     attrs["steady_state"] = int(steady.iloc[0]) if steady.size else -1
     return attrs
@@ -147,11 +142,7 @@ def write_event_file(tables, attrs, output, *, input, params=EventParams()):
 @register("analysis", NAME, VERSION, EventParams, consumes=("fem-run",), produces="event-table")
 def run(params, input, output):
     """Slip and microscopic events of a quasistatic fem run (steady state, rho(s), sequences)."""
-    from ..fem.output import read_increments, read_run_attrs  # the solver loads numba kernels
-
     run_attrs = read_run_attrs(input)
-    if "N" not in run_attrs:
-        raise FileFormatError(f"{input}: run attributes lack N")
     tables = event_tables(read_increments(input), int(run_attrs["N"]), source=str(input))
     write_event_file(tables, event_attrs(run_attrs, tables["increments"], source=str(input)), output, input=input,
                      params=params)

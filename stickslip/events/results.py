@@ -1,4 +1,4 @@
-"""Reading analysis files back (event tables, front tables) and grouping runs for figures.
+"""Reading analysis files of fem runs back (event tables, front tables) and grouping runs for figures.
 
 Figures group runs by what the files say about themselves (``regime``, ``n_interfaces``,
 ``N``, ``seed``), never by file names.
@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .. import h5io
+from ..formats.analysis_file import open_analysis_file
 from ..h5io import FileFormatError
 
 __all__ = ["AnalysisFile", "read_analysis_file", "group_runs", "pooled"]
@@ -58,12 +59,14 @@ def _python_value(value):
     return value
 
 
-def read_analysis_file(path, tables):
-    """Read the named tables and the root attributes of an analysis file.
+def read_analysis_file(path, fmt, tables):
+    """Read the named tables and the root attributes of an analysis file of a fem run.
 
     Parameters
     ----------
     path : str or pathlib.Path
+    fmt : str
+        The file's format (``"event-table"``, ``"front-table"``); its version is checked.
     tables : Iterable[str]
         Names of the tables to read (e.g. ``("increments", "slips")``).
 
@@ -74,11 +77,12 @@ def read_analysis_file(path, tables):
     Raises
     ------
     FileFormatError
-        If the file, a table, or the attributes ``n_interfaces``/``regime`` are missing.
+        If the file is not of format ``fmt`` in its current version, or a table or the attributes
+        ``n_interfaces``/``regime``/``phi`` are missing.
     """
-    with h5io.open_file(path) as file:
+    with open_analysis_file(path, fmt) as file:
         attrs = {key: _python_value(value) for key, value in file.attrs.items()}
-        for key in ("n_interfaces", "regime"):
+        for key in ("n_interfaces", "regime", "phi"):
             if key not in attrs:
                 raise FileFormatError(f"{path}: attribute '{key}' missing (not an analysis file of a fem run?)")
         data = {name: h5io.read_table(file, name) for name in tables}

@@ -79,7 +79,7 @@ def slip_table(increments, classified, N, *, T0=None):
     Parameters
     ----------
     increments : pandas.DataFrame
-        The run's increment table (:func:`stickslip.fem.output.read_increments`): ``t`` and, for a
+        The run's increment table (:func:`stickslip.formats.fem_run.read_increments`): ``t`` and, for a
         thermal run, ``held``.
     classified : pandas.DataFrame
         Its :func:`.extraction.classify_increments`.
@@ -195,7 +195,7 @@ def hold_tables(hold, states, params, T0, n_interfaces):
 @register("analysis", NAME, VERSION, ThermalEventParams, consumes=("fem-run",), produces="event-table")
 def run(params, input, output):
     """Slips with waiting times and aging rates, slow slip, and hold trials (thermal runs) of a fem run."""
-    from ..fem.output import read_increments, read_run_attrs
+    from ..formats.fem_run import read_increments, read_run_attrs
 
     run_attrs = read_run_attrs(input)
     if "N" not in run_attrs:

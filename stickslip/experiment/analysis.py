@@ -31,7 +31,7 @@ from ..params import ParameterError, param
 from . import aging, detection, kinematics
 from .timeseries import read_timeseries
 
-__all__ = ["ExperimentEventsParams", "analyse_record", "slip_events", "run", "NAME", "VERSION"]
+__all__ = ["ExperimentEventsParams", "analyse_record", "experimental_slip_events", "run", "NAME", "VERSION"]
 
 NAME = "experiment-events"
 VERSION = "2"
@@ -142,7 +142,7 @@ def analyse_record(record, params=ExperimentEventsParams()):
     return slips, interfaces
 
 
-def slip_events(slips):
+def experimental_slip_events(slips):
     """The normalised slip table (format ``event-table``) of :func:`analyse_record`'s ``slips``.
 
     Returns
@@ -165,5 +165,5 @@ def run(params, input, output):
     with h5io.open_file(input) as source:
         run_attrs = dict(source.attrs)
     write_analysis_file(output, "event-table", analysis=NAME, version=VERSION, params=params, input=input,
-                        attrs=run_attrs, tables={"slip_events": slip_events(slips), "slips": slips,
+                        attrs=run_attrs, tables={"slip_events": experimental_slip_events(slips), "slips": slips,
                                                  "interfaces": interfaces})

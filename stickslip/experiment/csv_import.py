@@ -29,7 +29,8 @@ import pandas as pd
 
 from ..h5io import FileFormatError
 from ..hashing import sha256_file
-from .timeseries import ExperimentRecord, validate_record, write_timeseries
+from ..output_safety.overwrite import claimed_output
+from .timeseries import FORMAT, ExperimentRecord, validate_record, write_timeseries
 
 __all__ = ["UNITS", "import_csv", "read_csv_columns"]
 
@@ -149,7 +150,8 @@ def _data_line_numbers(path, n_rows):
 
 
 def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stack", a=0, normal_force=49.0,
-               k_spring=55.0, h=10.0, H=100.0, V=0.01, time_unit=None, force_unit=None, position_unit=None):
+               k_spring=55.0, h=10.0, H=100.0, V=0.01, time_unit=None, force_unit=None, position_unit=None,
+               overwrite=False):
     """Convert a lab export (force CSV + positions CSV) into a time-series HDF5 file.
 
     Parameters
@@ -157,7 +159,9 @@ def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stac
     force_csv, positions_csv : str or pathlib.Path
         The two CSV files (layout in the module docstring).
     output : str or pathlib.Path
-        HDF5 file to write (atomically).
+        HDF5 file to write (atomically). An existing one is replaced only if it is an import of
+        the same two files with the same apparatus, or with ``overwrite``
+        (:func:`stickslip.output_safety.overwrite.claimed_output`).
     n : int
         Driven slabs (1 for the individual protocol).
     n_slabs : int, optional
@@ -170,6 +174,8 @@ def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stac
         (defaults: the paper's apparatus).
     time_unit, force_unit, position_unit : str, optional
         Units of columns whose header names none (see :data:`UNITS`).
+    overwrite : bool, optional
+        Replace an existing ``output`` that holds something else.
 
     Returns
     -------
@@ -180,6 +186,8 @@ def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stac
     ------
     stickslip.h5io.FileFormatError
         For a bad CSV file (naming file, column and line) or inconsistent metadata.
+    stickslip.output_safety.overwrite.OutputExistsError
+        If ``output`` holds something else and ``overwrite`` is false.
     """
     units = {"time": time_unit, "force": force_unit, "length": position_unit}
     force = read_csv_columns(force_csv, {"t": "time", "F": "force"}, units)
@@ -191,5 +199,8 @@ def import_csv(force_csv, positions_csv, output, *, n, n_slabs=5, protocol="stac
     validate_record(record, source=f"import of {force_csv} and {positions_csv}")  # before naming the output
     source = {"force_csv": {"name": Path(force_csv).name, "sha256": sha256_file(force_csv)},
               "positions_csv": {"name": Path(positions_csv).name, "sha256": sha256_file(positions_csv)}}
-    write_timeseries(output, record, attrs={"imported_from": source})
+    apparatus = {name: getattr(record, name) for name in ("n", "n_slabs", "protocol", "a", "normal_force", "k_spring",
+                                                           "h", "H", "V")}
+    with claimed_output(output, {"format": FORMAT, "imported_from": source, **apparatus}, overwrite=overwrite):
+        write_timeseries(output, record, attrs={"imported_from": source})
     return record

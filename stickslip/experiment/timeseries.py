@@ -22,6 +22,11 @@ attr ``V``       float               lever-top speed actually imposed [mm/s]
 attr ``format``  str                 ``"timeseries"``, with ``format_version``
 ===============  ==================  ==============================================
 
+A dataset may carry its unit as the attribute ``unit`` (or ``units``); it must then be the one
+above. A file written outside stickslip (a lab script following ``shared/design.md``) has no
+``format`` attributes: it is read as version 1, checked by its content (every dataset and
+attribute above, shapes, finite values, strictly increasing times), with a one-line note.
+
 Protocols (paper, section "Experiments" and appendix "Individual sliding"):
 
 - ``"stack"``: slabs 1..n carry a spring (n = 1..n_slabs), the slabs above ride
@@ -38,10 +43,12 @@ and ``interfaces`` (one row per interface), see :mod:`stickslip.solvers.lever`.
 """
 
 import dataclasses
+import sys
 
 import numpy as np
 
 from .. import formats, h5io
+from ..output_safety.atomic import atomic_output
 
 __all__ = ["FORMAT", "PROTOCOLS", "ExperimentRecord", "write_timeseries", "read_timeseries", "read_truth",
            "validate_record", "describe"]
@@ -53,6 +60,10 @@ FORMAT = "timeseries"
 PROTOCOLS = ("stack", "individual")
 
 _DATASETS = ("t_F", "F", "t_x", "x")
+#: The unit of every dataset.
+_UNITS = {"t_F": "s", "F": "N", "t_x": "s", "x": "mm"}
+#: Where the layout is described for other writers.
+_LAYOUT = "docs/experimental-analysis.md, 'File layout'"
 _INT_ATTRS = ("n", "n_slabs", "a")
 _FLOAT_ATTRS = ("normal_force", "k_spring", "h", "H", "V")
 # Lossless and deterministic; halves a 6000 s run (6.2 -> 2.9 MB) for ~0.1 s of writing.
@@ -216,7 +227,7 @@ def write_timeseries(path, record, *, attrs=None, tables=None):
     clashes = sorted(reserved & (set(attrs or {}) | set(tables or {})))
     if clashes:
         raise ValueError(f"extra attributes/tables must not reuse the format's names: {', '.join(clashes)}")
-    with h5io.atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
+    with atomic_output(path) as tmp, h5io.open_file(tmp, "w") as f:
         formats.stamp(f, FORMAT)
         for name in _DATASETS:
             h5io.write_dataset(f, name, np.asarray(getattr(record, name), dtype=np.float64), **_COMPRESSION)
@@ -245,38 +256,59 @@ def read_timeseries(path):
     ------
     stickslip.h5io.FileFormatError
         If the file is missing or unreadable, a required dataset or attribute is
-        absent or of the wrong kind, or the content fails :func:`validate_record`;
-        the message names the file and the item. (``a`` is required for the
-        individual protocol only; a stack recording without it reads as ``a = 0``.)
+        absent or of the wrong kind, a dataset states another unit, or the content
+        fails :func:`validate_record`; the message names the file and the item. (``a``
+        is required for the individual protocol only; a stack recording without it
+        reads as ``a = 0``.) A file without ``format`` attributes (a lab recording) is
+        read as version 1 when its content passes, with a note on stderr.
     """
-    source = str(path)
-    values = {}
     with h5io.open_file(path) as f:
-        formats.check(f, FORMAT)
-        for name in _DATASETS:
-            if name not in f:
-                _fail(source, name, "is missing (required dataset)")
-            data = h5io.read_array(f[name])
-            if data.dtype.kind not in "fiu":
-                _fail(source, name, f"must be numeric, got dtype {data.dtype}")
-            values[name] = np.asarray(data, dtype=np.float64)
-        for name in ("protocol",) + _INT_ATTRS + _FLOAT_ATTRS:
-            if name not in f.attrs and name != "a":
-                _fail(source, name, "is missing (required attribute)")
-        protocol = f.attrs["protocol"]
-        values["protocol"] = protocol.decode() if isinstance(protocol, bytes) else str(protocol)
-        if "a" not in f.attrs and values["protocol"] == "individual":
-            _fail(source, "a", "is missing (required attribute of the individual protocol: the driven slab)")
-        for name in _INT_ATTRS:
-            value = f.attrs.get(name, 0)  # only a of a stack recording may be absent: 0
-            if not (np.issubdtype(type(value), np.integer) or (isinstance(value, float) and value.is_integer())):
-                _fail(source, name, f"must be an integer, got {_plain(value)!r}")
-            values[name] = int(value)
-        for name in _FLOAT_ATTRS:
-            value = f.attrs[name]
-            if not np.issubdtype(type(value), np.number) or np.ndim(value) != 0:
-                _fail(source, name, f"must be a number, got {_plain(value)!r}")
-            values[name] = float(value)
+        stamped = formats.check(f, FORMAT)
+        try:
+            record = _read_record(f, str(path))
+        except h5io.FileFormatError as error:
+            if stamped:
+                raise
+            raise h5io.FileFormatError(f"{error} (a file without a 'format' attribute is read as a lab recording "
+                                       f"in the documented layout: {_LAYOUT})") from None
+    if not stamped:
+        print(f"stickslip: note: {path}: no 'format' attribute; read as a lab recording in the documented layout "
+              f"({FORMAT} version 1), checked by its content", file=sys.stderr)
+    return record
+
+
+def _read_record(f, source):
+    """The record of an open time-series file, checked (see :func:`read_timeseries`)."""
+    values = {}
+    for name in _DATASETS:
+        if name not in f:
+            _fail(source, name, "is missing (required dataset)")
+        unit = f[name].attrs.get("unit", f[name].attrs.get("units"))
+        unit = unit.decode() if isinstance(unit, bytes) else unit
+        if unit is not None and unit != _UNITS[name]:
+            _fail(source, name, f"is in [{unit}]; the format stores it in [{_UNITS[name]}] (convert it, or "
+                                f"import the lab's CSV with `stickslip import-csv`, which converts units)")
+        data = h5io.read_array(f[name])
+        if data.dtype.kind not in "fiu":
+            _fail(source, name, f"must be numeric, got dtype {data.dtype}")
+        values[name] = np.asarray(data, dtype=np.float64)
+    for name in ("protocol",) + _INT_ATTRS + _FLOAT_ATTRS:
+        if name not in f.attrs and name != "a":
+            _fail(source, name, "is missing (required attribute)")
+    protocol = f.attrs["protocol"]
+    values["protocol"] = protocol.decode() if isinstance(protocol, bytes) else str(protocol)
+    if "a" not in f.attrs and values["protocol"] == "individual":
+        _fail(source, "a", "is missing (required attribute of the individual protocol: the driven slab)")
+    for name in _INT_ATTRS:
+        value = f.attrs.get(name, 0)  # only a of a stack recording may be absent: 0
+        if not (np.issubdtype(type(value), np.integer) or (isinstance(value, float) and value.is_integer())):
+            _fail(source, name, f"must be an integer, got {_plain(value)!r}")
+        values[name] = int(value)
+    for name in _FLOAT_ATTRS:
+        value = f.attrs[name]
+        if not np.issubdtype(type(value), np.number) or np.ndim(value) != 0:
+            _fail(source, name, f"must be a number, got {_plain(value)!r}")
+        values[name] = float(value)
     record = ExperimentRecord(**values)
     validate_record(record, source=source)
     return record
@@ -323,4 +355,4 @@ def describe(path):
         protocol = f.attrs["protocol"]
         seed = f.attrs.get("seed")
         return {"protocol": protocol.decode() if isinstance(protocol, bytes) else str(protocol),
-                "n": int(f.attrs["n"]), "a": int(f.attrs["a"]), "seed": None if seed is None else int(seed)}
+                "n": int(f.attrs["n"]), "a": int(f.attrs.get("a", 0)), "seed": None if seed is None else int(seed)}

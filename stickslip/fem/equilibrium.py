@@ -26,10 +26,11 @@ positive definite (the bottom edge is fixed): it is factorised once with SuperLU
 the exact stiffness and one iteration is the solution.
 
 The iterations stop when the relative residual (:func:`.dynamics.residual`, at rest)
-is below ``tol^2`` (the dynamic protocol's strict criterion), or when the smallest residual
-has not halved in the last ``STALL`` iterations, neither in one of them nor over all of them
-(round-off floor, or no convergence; a law whose curvature is well below the matrix's, as the
-smooth law's beyond an inflection, contracts steadily but more slowly than by half per iteration), or after
+is below ``tol^2`` (the dynamic protocol's strict criterion), or when no iteration of the last
+``STALL`` has halved the smallest residual and it is below ``tol`` (a round-off floor) or has not
+halved over those ``STALL`` iterations together either (no convergence; a law whose curvature is
+well below the matrix's, as the smooth law's beyond an inflection, contracts steadily but by less
+than half per iteration, and goes on), or after
 ``MAX_NEWTON`` iterations; the result counts only if its residual is below ``tol^2``, or
 below ``tol`` at a stall (a round-off floor above ``tol^2``, for a very small ``tol``). All operations are serial and in a fixed order: the result
 is the same bit for bit on every run.
@@ -152,7 +153,9 @@ class WellEquilibrium:
         stalled = 0  # consecutive iterations that did not halve it
         stuck = False
         for _ in range(MAX_NEWTON):
-            stuck = stalled >= STALL and best > 0.5 * bests[-1 - STALL]
+            # stalled: no iteration halved the residual in the last STALL; stuck: not even all of them
+            # together, or the residual is below tol already (a round-off floor, accepted below)
+            stuck = stalled >= STALL and (best < tol or best > 0.5 * bests[-1 - STALL])
             if best <= tol * tol or stuck:
                 break
             trial.u[self.free] -= self.solve(trial.f[self.free])

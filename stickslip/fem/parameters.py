@@ -7,11 +7,12 @@ dimensionless. See docs/fem.md and shared/reference-model.md (section 11).
 
 import dataclasses
 
-from ..params import ParameterError, param
+from ..formats import fem_run
+from ..params import ParameterError, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS
 
-__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS"]
+__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "stored_params"]
 
 #: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
 DRIVES = ("fixed-lever", "free-lever")
@@ -69,10 +70,15 @@ class FemParams:
                                 "third of the interface, L / (3 c_s), about 30 N steps at dt_scale 1 (shorter "
                                 "windows end events early: docs/fem.md)", minimum=0)
     margin: int = param(5, "a block within this many wells of the end of its held sequence stops the run "
-                           "('stop') or makes the event be redone with more wells held ('extend')", minimum=1)
+                           "('stop') or makes the event be redone with more wells held ('extend'; with "
+                           "max_increments 0 a block within this many wells of the end of its first nchunk wells "
+                           "stops the run)", minimum=1)
     lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",
                                 unit="H_1 - H_0 (mid-height distance of layers 1 and 0)", exclusive_minimum=0.0)
-    max_increments: int = param(0, "stop after this many increments (0: run until the margin stop)", minimum=0)
+    max_increments: int = param(0, "stop after this many increments; 0: stop where the paper's code does, when a "
+                                   "block comes within `margin` wells of the end of its first `nchunk` wells (with "
+                                   "'stop' the increment is aborted there; with 'extend' it is completed, not "
+                                   "stored)", minimum=0)
     interface_law: str = param("cusp", "potential of the interface blocks in a well: 'cusp' (parabolas joined by "
                                        "cusps, the paper's) or 'smooth' (wells joined smoothly; docs/fem.md)",
                                choices=INTERFACE_LAWS, extension=True)
@@ -108,9 +114,23 @@ class FemParams:
                 if getattr(self, name) != field.default:
                     raise ParameterError(f"parameter '{name}': used only with temperature > 0; expected a "
                                          "temperature > 0 or the default")
-        if self.yield_strains == "extend" and self.max_increments == 0:
-            raise ParameterError("parameter 'max_increments': 0 with yield_strains = 'extend' would run forever; "
-                                 "expected max_increments > 0 (or yield_strains = 'stop')")
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
+
+
+def stored_params(file):
+    """The :class:`FemParams` of an open ``fem-run`` file (stored there as the producer's opaque JSON).
+
+    Parameters
+    ----------
+    file : h5py.File
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the file is not a ``fem-run`` file of the current version.
+    stickslip.params.ParameterError
+        If its parameters are not those of a :class:`FemParams`.
+    """
+    return parse_params(FemParams, fem_run.read_params(file), owner=f"{file.filename}: params")

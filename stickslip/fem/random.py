@@ -20,7 +20,7 @@ import numpy as np
 
 from ..numba_options import njit
 
-__all__ = ["pcg32_seed", "pcg32_next", "pcg32_uint32", "pcg32_uniform", "weibull_rows"]
+__all__ = ["pcg32_seed", "pcg32_next", "pcg32_uint32", "pcg32_uniform"]
 
 _MULTIPLIER = np.uint64(6364136223846793005)
 _ONE = np.uint64(1)
@@ -125,25 +125,3 @@ def pcg32_uniform(initstate, initseq, ncol):
     initstate, initseq = _as_seeds(initstate, initseq)
     return pcg32_uint32(initstate, initseq, int(ncol)).astype(np.float64) / 2.0**32
 
-
-def weibull_rows(initstate, initseq, ncol, k, scale=1.0):
-    """Weibull variates, one pcg32 generator per row.
-
-    Parameters
-    ----------
-    initstate, initseq : array_like of int
-        [nrow] seeds (``initseq`` may be a scalar).
-    ncol : int
-        Draws per generator.
-    k : float
-        Shape parameter (> 0).
-    scale : float, optional
-        Scale parameter lambda (> 0).
-
-    Returns
-    -------
-    numpy.ndarray
-        float64 [nrow, ncol]: ``scale * (-log(1 - r)) ** (1 / k)``.
-    """
-    r = pcg32_uniform(initstate, initseq, ncol)
-    return scale * np.power(-np.log(1.0 - r), 1.0 / k)

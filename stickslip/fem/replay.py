@@ -11,9 +11,10 @@ For a thermal run it also holds a stored state at a load and reloads it
 import numpy as np
 import pandas as pd
 
-from ..h5io import FileFormatError, open_file, read_table
+from ..formats.fem_run import RunFile
+from ..h5io import FileFormatError, open_file
 from .backends import make_backend
-from .output import RunFile
+from .parameters import stored_params
 from .system import System
 
 __all__ = ["EventReplay"]
@@ -40,11 +41,11 @@ class EventReplay:
         self.path = path
         with open_file(path) as file:
             run = RunFile(file)
-            self.params, self.nstored = run.params, run.nstored
-            table = read_table(file, "increments", rows=run.nstored)
+            self.params, self.nstored = stored_params(file), run.nstored
+            table = run.increments()
             response = run.linear_response()
             self.N = run.mesh.N
-            self.system = System(run.params, run.mesh, backend or make_backend(run.params.backend))
+            self.system = System(self.params, run.mesh, backend or make_backend(self.params.backend))
         self._kick = table["kick"].to_numpy(dtype=bool)
         self._yield_element = table["yield_element"].to_numpy(dtype=bool)
         self.system.set_linear_response(*response)

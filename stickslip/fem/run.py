@@ -7,7 +7,10 @@ the brink of yielding (odd increments), and a kick followed by minimisation
 redone so that a whole element yields (``yield_element``). The run stops, and
 is marked completed, when a block comes within ``margin`` wells of the end of
 its yield strains (during a minimisation, or after a load step), or after
-``max_increments`` increments. Every increment is appended and committed; a run
+``max_increments`` increments; with unbounded yield strains and ``max_increments``
+0, when an increment leaves a block within ``margin`` wells of the end of its
+first ``nchunk`` wells (where the paper's code stops; that increment is not
+stored). Every increment is appended and committed; a run
 ended in any way (exception, SIGINT, SIGTERM, SIGKILL) resumes from its last
 committed increment and gives the same file, byte for byte, as an uninterrupted
 run. Progress (increments, slip events so far, increments/s, time left when
@@ -16,18 +19,21 @@ Reference: shared/reference-model.md, section 8c.
 """
 
 import json
-import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from .. import progress
-from ..h5io import (FileFormatError, UnreadableFileError, atomic_output, check_free_space, open_file, read_table,
-                    writer_lock)
+from ..formats.fem_run import RunFile, append_increment, create_file, rewrite
+from ..h5io import FileFormatError, UnreadableFileError, open_file, read_table
+from ..output_safety.atomic import atomic_output
+from ..output_safety.lock import writer_lock
+from ..output_safety.overwrite import set_aside
+from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .observables import Observer, observable_columns
-from .output import RunFile, append_increment, create_file, read_params, rewrite
+from .parameters import stored_params
 from .protocol import make_protocol
 from .stiffness import driving_regime, stiffness_ratio
 from .system import System
@@ -71,7 +77,8 @@ class _Progress:
 
 
 def _header(system, observer, protocol, producer):
-    """Root attributes of the run file: the producing solver, parameters, normalisation, the protocol's own."""
+    """Root attributes of the run file: the fields of :data:`stickslip.formats.fem_run.HEADER`, then ``fem``'s own
+    (the protocol's last)."""
     p, c = system.params, system.constants
     phi = stiffness_ratio(p.k_drive, p.N, p.G)
     return {"solver": producer[0], "solver_version": producer[1], "params": params_to_dict(p),
@@ -108,26 +115,15 @@ def _stored(output, params):
         return None
     try:
         with open_file(output) as file:
-            stored = read_params(file)
+            stored = stored_params(file)
             completed = bool(file.attrs["completed"])
     except UnreadableFileError as error:
-        aside = _aside(output)
-        os.replace(output, aside)
+        aside = set_aside(output, "unreadable")
         print(f"stickslip: {error}; moved it to {aside}, starting the run over", file=sys.stderr)
         return None
     if params_to_dict(stored) != params_to_dict(params):
         raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
     return completed
-
-
-def _aside(path):
-    """A free name ``<name>.unreadable[-<k>]`` beside ``path``."""
-    aside = path.with_name(f"{path.name}.unreadable")
-    k = 1
-    while aside.exists():
-        k += 1
-        aside = path.with_name(f"{path.name}.unreadable-{k}")
-    return aside
 
 
 def run_simulation(params, output, mesh, backend, *, producer):
@@ -136,7 +132,7 @@ def run_simulation(params, output, mesh, backend, *, producer):
     While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,
     e.g. by ``stickslip increments``), one committed increment at a time. However
     the run ends (an exception, SIGINT, SIGTERM, SIGKILL), the next call rewrites
-    the file from its committed increments (:func:`.output.rewrite`) and resumes;
+    the file from its committed increments (:func:`stickslip.formats.fem_run.rewrite`) and resumes;
     a file that HDF5 cannot open is moved aside with a message and the run starts
     over. A disk that fills up ends the run before an increment is written
     (:data:`FREE_SPACE_MARGIN`); it resumes when rerun with space. A finished run is rewritten once more, so that the file has the same bytes
@@ -201,6 +197,7 @@ def _increments(params, output, backend):
         reason = ""
         report = _Progress(file, params, increment)
         needed = 2 * run.increment_bytes() + FREE_SPACE_MARGIN
+        last_well = params.nchunk + 1 - params.margin if system.extend and not params.max_increments else None
         while not reason:
             if params.max_increments and increment >= params.max_increments:
                 reason = "max_increments"
@@ -211,7 +208,10 @@ def _increments(params, output, backend):
             if columns is None:
                 reason = "margin"
                 break
-            check_free_space(output, needed)
+            if last_well is not None and system.well_index().max() >= last_well:
+                reason = "margin"
+                break
+            check_free_space(output, needed, FREE_SPACE_MARGIN)
             row = _row(observer, increment, kick, previous_index, columns)
             append_increment(file, system.snapshot(), row)
             protocol.stored(row)

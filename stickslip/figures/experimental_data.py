@@ -16,6 +16,8 @@ import pandas as pd
 
 from .. import h5io
 from ..experiment.timeseries import read_timeseries
+from ..formats import event_table
+from ..formats.analysis_file import open_analysis_file
 
 __all__ = ["EVENTS", "load_slips", "load_interfaces", "example_run", "median_run", "excerpt"]
 
@@ -47,7 +49,7 @@ def _run_attrs(f, path):
 def _load(paths, table, shuffled):
     frames = []
     for path in sorted(map(str, paths)):
-        with h5io.open_file(path) as f:
+        with open_analysis_file(path, event_table.FORMAT) as f:
             attrs = _run_attrs(f, path)
             if attrs["shuffled"] and not shuffled:
                 continue

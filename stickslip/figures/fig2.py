@@ -7,7 +7,7 @@ interface, multi-slip drops black. (c) rho(s), the fraction of slip events invol
 interfaces, for every n: stiff dashed, compliant solid. (f) Density of the stress drop
 Delta mu_a [sig0] of the slipping interface in single-slip events, compliant driving, every n,
 with Welch's test of equal means between the smallest and the largest n and the shift it
-would detect (:mod:`stickslip.events.shift_test`).
+would detect (:mod:`stickslip.events.mean_shift`).
 Runs at the paper's Phi (5e-4 stiff, 5e-7 compliant) are pooled by (regime, n) over seeds; the
 panel texts give N, Phi and the number of events.
 """
@@ -18,7 +18,7 @@ import numpy as np
 
 from ..events.extraction import interfaces_in, slip_fractions
 from ..events.results import group_runs, pooled
-from ..events.shift_test import shift_test
+from ..events.mean_shift import shift_test
 from ..params import param
 from ..registry import register
 from .numerical_common import REGIME_LINESTYLE, read_inputs, run_phi

@@ -22,6 +22,8 @@ import pandas as pd
 
 from .. import h5io, registry
 from ..experiment import aging
+from ..formats import event_table
+from ..formats.analysis_file import open_analysis_file
 from ..params import param
 from .experimental_data import EVENTS, load_slips
 from .experimental_panels import single_slips
@@ -47,7 +49,7 @@ def run_pairs(paths):
     from the ``params`` attribute the events files copy from their runs."""
     rows = []
     for path in sorted(map(str, paths)):
-        with h5io.open_file(path) as f:
+        with open_analysis_file(path, event_table.FORMAT) as f:
             text = f.attrs.get("params")
         values = json.loads(text) if text is not None else {}
         if "rs_a" not in values or "rs_b" not in values:

@@ -3,10 +3,14 @@ figS-event-maps, figS-tau): reading their inputs, line styles per driving regime
 """
 
 from ..events.results import read_analysis_file
-from ..fem.stiffness import at_paper_phi, stiffness_ratio
+from ..fem.stiffness import at_paper_phi
+from ..formats import event_table, front_table
 from ..h5io import FileFormatError
 
-__all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "read_inputs", "run_phi"]
+__all__ = ["REGIME_LINESTYLE", "REGIME_LABEL", "INPUT_FORMATS", "read_inputs", "run_phi"]
+
+#: The format of each input category of the numerical figures.
+INPUT_FORMATS = {"analysis:numerical-events": event_table.FORMAT, "analysis:front-dynamics": front_table.FORMAT}
 
 #: The paper's convention: stiff driving dashed, compliant solid.
 REGIME_LINESTYLE = {"stiff": "--", "compliant": "-"}
@@ -16,10 +20,8 @@ REGIME_LABEL = {"stiff": r"stiff driving, $\Phi \simeq 5 \times 10^{-4}$",
 
 
 def run_phi(attrs):
-    """Phi of the run an analysis file comes from (its ``phi`` attribute, or from ``k_drive`` and ``N``)."""
-    if "phi" in attrs:
-        return float(attrs["phi"])
-    return stiffness_ratio(attrs["k_drive"], attrs["N"])
+    """Phi of the run an analysis file comes from: its ``phi`` attribute, as the run file states it (float)."""
+    return float(attrs["phi"])
 
 
 def read_inputs(inputs, category, tables, figure, paper_phi=True):
@@ -30,7 +32,7 @@ def read_inputs(inputs, category, tables, figure, paper_phi=True):
     inputs : Mapping[str, Sequence[str or pathlib.Path]]
         The figure's inputs, by category.
     category : str
-        E.g. ``"analysis:numerical-events"``.
+        A key of :data:`INPUT_FORMATS`, e.g. ``"analysis:numerical-events"``.
     tables : tuple[str, ...]
         Tables to read from each file.
     figure : str
@@ -47,12 +49,12 @@ def read_inputs(inputs, category, tables, figure, paper_phi=True):
     Raises
     ------
     FileFormatError
-        If the category has no file (at the paper's Phi).
+        If the category has no file (at the paper's Phi), or a file is not of the category's format.
     """
     paths = list(inputs.get(category, []))
     if not paths:
         raise FileFormatError(f"figure '{figure}': no input file of category '{category}'")
-    files = [read_analysis_file(path, tables) for path in paths]
+    files = [read_analysis_file(path, INPUT_FORMATS[category], tables) for path in paths]
     if paper_phi:
         files = [item for item in files if at_paper_phi(run_phi(item.attrs))]
         if not files:

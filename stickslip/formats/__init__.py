@@ -13,15 +13,20 @@ Built-in formats (``docs/developing.md`` draws the data flow):
 format         reader/writer                            producers -> consumers
 =============  =======================================  ========================================
 mesh           :mod:`stickslip.mesh.io`                 mesh stage -> ``fem`` (solver input), figS-mesh
-fem-run        :mod:`stickslip.fem.output`              ``fem`` -> numerical-events, front-dynamics
+fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics
 timeseries     :mod:`stickslip.experiment.timeseries`   ``lever``, lab CSV import -> experiment-events
 event-table    :mod:`stickslip.formats.event_table`     numerical-events, experiment-events -> figures, database
-front-table    :mod:`stickslip.events.fronts`           front-dynamics -> figS-event-maps, figS-tau
+front-table    :mod:`stickslip.formats.front_table`     front-dynamics -> figS-event-maps, figS-tau
 =============  =======================================  ========================================
 
 A simulation format says what kind of data it holds (``source``: "numerical" or
 "experimental") and may describe a file by the typed columns of the results database
 (``describe``); the database ingests formats, never file names.
+
+A format whose files are also written outside stickslip (lab recordings, ``timeseries``) names
+the version that a file without ``format`` and ``format_version`` is read as (``unstamped``);
+its reader then validates the file by its content. A file that states another format is
+refused as any other.
 
 A third-party package adds a format with :func:`register_format` in the module its entry
 point imports.
@@ -63,6 +68,10 @@ class Format:
         ``"module:function"``: ``function(path) -> dict`` of the database's simulation
         columns (``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
         ``phi``, ``regime``, ``seed``, ``temperature``, ``attempt_rate``, ``drive_rate``) read from one file.
+    unstamped : int or None
+        The version a file without ``format`` attributes is read as (its layout is
+        documented for other writers, e.g. lab scripts; the reader validates the
+        content); None: such a file is refused.
     """
 
     name: str
@@ -71,6 +80,7 @@ class Format:
     summary: str
     source: str | None = None
     describe: str | None = None
+    unstamped: int | None = None
 
 
 _formats = {}
@@ -144,6 +154,13 @@ def check(file, name):
     file : h5py.File
     name : str
 
+    Returns
+    -------
+    bool
+        True if the file states its format; False if it states none and the format
+        reads such files (``Format.unstamped``, the current version): the caller must
+        then validate the content, and may say so.
+
     Raises
     ------
     FileFormatError
@@ -152,6 +169,8 @@ def check(file, name):
     fmt = get_format(name)
     found = file.attrs.get("format")
     found = found.decode() if isinstance(found, bytes) else found
+    if found is None and "format_version" not in file.attrs and fmt.unstamped == fmt.version:
+        return False
     if found is None:
         raise FileFormatError(f"{file.filename}: no 'format' attribute (expected a {name} file, version "
                               f"{fmt.version}; written by an older stickslip? rerun the job that made it)")
@@ -159,6 +178,7 @@ def check(file, name):
     if found != name or version != fmt.version:
         raise FileFormatError(f"{file.filename}: a {found} file version {version}, expected {name} version "
                               f"{fmt.version}")
+    return True
 
 
 def describe(name, path):
@@ -182,14 +202,14 @@ def describe(name, path):
 
 for _builtin in (
         Format("mesh", 1, "stickslip.mesh.io", "a layered Quad4 mesh (coordinates, connectivity, layers)"),
-        Format("fem-run", 1, "stickslip.fem.output", "a quasistatic finite-element run: header, mesh, linear "
+        Format("fem-run", 1, "stickslip.formats.fem_run", "a quasistatic finite-element run: header, mesh, linear "
                "response, one state and one row of observables per increment", source="numerical",
-               describe="stickslip.fem.output:describe"),
+               describe="stickslip.formats.fem_run:describe"),
         Format("timeseries", 1, "stickslip.experiment.timeseries", "an experimental recording: lever force F(t), "
                "slab positions x(t), apparatus attributes", source="experimental",
-               describe="stickslip.experiment.timeseries:describe"),
+               describe="stickslip.experiment.timeseries:describe", unstamped=1),
         Format("event-table", 1, "stickslip.formats.event_table", "slip events: one row per (event, slipping "
                "interface) in the table 'slip_events', plus the analysis's own tables"),
-        Format("front-table", 1, "stickslip.events.fronts", "re-run events: block failures and rupture fronts"),
+        Format("front-table", 1, "stickslip.formats.front_table", "re-run events: block failures and rupture fronts"),
 ):
     register_format(_builtin)

@@ -18,6 +18,7 @@ the header's names win over copied ones.
 
 from .. import h5io
 from ..hashing import canonical_json, sha256_file
+from ..output_safety.atomic import atomic_output
 from ..params import params_to_dict
 from . import check, stamp
 
@@ -48,7 +49,7 @@ def write_analysis_file(output, fmt, *, analysis, version, params, input, attrs,
     """
     header = {"analysis": analysis, "analysis_version": version,
               "analysis_params": canonical_json(params_to_dict(params)), "input_sha256": sha256_file(input)}
-    with h5io.atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
+    with atomic_output(output) as tmp, h5io.open_file(tmp, "w") as file:
         h5io.write_attrs(file, {key: value for key, value in attrs.items() if key not in HEADER})
         h5io.write_attrs(file, header)
         stamp(file, fmt)

@@ -9,8 +9,9 @@ Layout of a mesh group: datasets ``coor`` [nnode, 2], ``conn`` [nelem, 4],
 from pathlib import Path
 
 from .. import formats
-from ..h5io import FileFormatError, atomic_output, open_file, read_array, write_attrs, write_dataset
+from ..h5io import FileFormatError, open_file, read_array, write_attrs, write_dataset
 from ..hashing import short_hash
+from ..output_safety.atomic import atomic_output
 from ..params import ParameterError, params_to_dict, parse_params
 from .layered import LayeredMesh, MeshParams, build_stack_mesh
 

@@ -128,13 +128,24 @@ def code_hash(module):
 
     Notes
     -----
-    Cost: reads and parses each source once per process (the file list is
-    cached; the contents are read on every call, so edits are seen).
+    Cost: parses each source once per process (the file list is cached); the
+    sources are hashed again only when one of them changed (size or modification
+    time), so the workflow, which asks once per job, hashes each plugin once.
     """
-    digest = hashlib.sha256()
-    for path in module_sources(module):
-        digest.update((path.relative_to(ROOT.parent).as_posix() if path.is_relative_to(ROOT) else path.name).encode())
-        digest.update(b"\0")
-        digest.update(path.read_bytes())
-        digest.update(b"\0")
-    return digest.hexdigest()[:16]
+    sources = module_sources(module)
+    stamp = tuple((path, path.stat().st_mtime_ns, path.stat().st_size) for path in sources)
+    cached = _hashes.get(module)
+    if cached is None or cached[0] != stamp:
+        digest = hashlib.sha256()
+        for path in sources:
+            digest.update((path.relative_to(ROOT.parent).as_posix() if path.is_relative_to(ROOT) else path.name)
+                          .encode())
+            digest.update(b"\0")
+            digest.update(path.read_bytes())
+            digest.update(b"\0")
+        cached = _hashes[module] = (stamp, digest.hexdigest()[:16])
+    return cached[1]
+
+
+#: code_hash by module: (the sources' paths, modification times and sizes, the hash).
+_hashes = {}

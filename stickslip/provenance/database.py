@@ -22,7 +22,7 @@ from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
 
 from ..h5io import FileFormatError
 
-__all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "Artifact", "Simulation", "SlipEvent", "Figure",
+__all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "ArtifactRow", "Simulation", "SlipEvent", "Figure",
            "VIEWS", "engine_for", "create_schema"]
 
 #: Version of the table layout; a database of another version must be rebuilt (``stickslip db
@@ -72,8 +72,8 @@ class Run(Base):
     record_path: Mapped[str] = mapped_column(String, doc="the provenance JSON file")
 
 
-class Artifact(Base):
-    """One input or output file of a run."""
+class ArtifactRow(Base):
+    """One input or output file of a run (a row of ``artifacts``; in memory: :class:`stickslip.lineage.Artifact`)."""
 
     __tablename__ = "artifacts"
     id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)

@@ -29,9 +29,10 @@ from sqlalchemy.orm import Session
 
 from .. import formats, registry
 from ..formats import event_table
-from ..h5io import FileFormatError, atomic_output
+from ..h5io import FileFormatError
+from ..output_safety.atomic import atomic_output
 from ..progress import iterate
-from .database import Artifact, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
+from .database import ArtifactRow, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
 
 __all__ = ["ingest", "find_records"]
@@ -143,13 +144,13 @@ def _figure_row(record):
 def _ingest_record(session, record, record_file):
     """Replace the rows of one run by those of its record; return the number of slip events added."""
     run_id = record["run_id"]
-    for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (Artifact, Artifact.run_id),
+    for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (ArtifactRow, ArtifactRow.run_id),
                        (Simulation, Simulation.run_id), (Figure, Figure.run_id), (Run, Run.run_id)):
         session.execute(delete(model).where(key == run_id))
     session.execute(insert(Run), [_run_row(record, record_file)])
     artifacts = _artifact_rows(record)
     if artifacts:
-        session.execute(insert(Artifact), artifacts)
+        session.execute(insert(ArtifactRow), artifacts)
     events = []
     if record["kind"] == "solver":
         session.execute(insert(Simulation), [_simulation_row(record, record_file)])

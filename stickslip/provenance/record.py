@@ -22,9 +22,10 @@ from contextlib import contextmanager
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from ..h5io import FileFormatError, atomic_output
+from ..h5io import FileFormatError
 from ..hashing import sha256_file
 from ..lineage import Artifact
+from ..output_safety.atomic import atomic_output
 
 __all__ = ["SCHEMA_VERSION", "REQUIRED_FIELDS", "record_path", "file_entry", "check_recorded_sha256", "git_state",
            "library_versions", "peak_memory_mib", "write_record", "read_record", "recording"]

@@ -3,7 +3,7 @@
 Parameters: :class:`stickslip.fem.parameters.FemParams` (every field documented
 with its unit; ``stickslip plugins --params`` lists them). The mesh is read from
 ``inputs["mesh"]`` (a file of :func:`stickslip.mesh.write_mesh`) when given, else
-built from ``N`` and ``plates``. The output file (layout: :mod:`stickslip.fem.output`)
+built from ``N`` and ``plates``. The output file (format ``fem-run``, :mod:`stickslip.formats.fem_run`)
 is appended after every increment; an existing incomplete file with the same
 parameters is resumed, a completed one is left as it is.
 """

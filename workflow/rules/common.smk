@@ -9,7 +9,7 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from stickslip.params import ParameterError
+from stickslip.params import ParameterError, did_you_mean
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
 from stickslip.study import Study, check_sweeps, normalise, plugin_sections
@@ -29,6 +29,12 @@ def _validate(section, schema, key):
         for item in re.findall(r"\[([^\]]*)\]", instance.group(1) if instance else ""):
             key = f"{key}.{item.strip(chr(39))}" if item.startswith("'") else f"{key}[{item}]"
         message = detail.split("\n\n")[0].removeprefix("ValidationError: ")
+        unexpected = re.search(r"Additional properties are not allowed \('([^']*)' was unexpected", message)
+        if unexpected and not key:  # a top-level key: name it, not the (unnamed) config it is in
+            path = Path(schema) if Path(schema).is_absolute() else Path(workflow.basedir, "workflow", "rules", schema)
+            known = list(yaml.safe_load(path.read_text())["properties"])
+            key, message = unexpected.group(1), (f"not a key of the config{did_you_mean(unexpected.group(1), known)}; "
+                                                 f"allowed: {', '.join(known)}")
         raise WorkflowError(f"config key {key.lstrip('.')}: {message}") from None
 
 
@@ -86,3 +92,12 @@ onstart:
         # submitted jobs are cancelled (scancel). Snakemake's own SIGTERM handler waits for them instead, for
         # hours or, for a job that never starts, forever.
         raise_interrupt_on_sigterm()
+
+
+onsuccess:
+    # A completed simulation keeps a second name under sim/{solver}/partial/ until Snakemake has seen its job
+    # finish, so that a job that completed while Snakemake was stopped is not recomputed by the rerun
+    # (stickslip.workflow_api.run_simulation); after a successful run Snakemake has seen them all.
+    from stickslip.workflow_api import release_completed
+
+    release_completed(STUDY.root)

@@ -121,7 +121,7 @@ def step(y, fy, h, gamma, alpha, Gamma, weights, error_weights, stages, y_new, e
     local ``error`` (both float64 [n]); ``stages`` float64 [s, n] and ``work`` float64 [2, n] are
     scratch, ``factors`` from :func:`.slab_linear_system.new_factors`; ``args`` those of
     :func:`.slab_equations.rhs` after ``y``; returns None."""
-    n, s = y.size, weights.size
+    s = weights.size
     c = gamma * h
     factorize(y, c, factors, *args)
     point, right = work[0], work[1]

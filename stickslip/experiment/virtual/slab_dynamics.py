@@ -31,7 +31,6 @@ Units: lengths [mm], forces [N], masses [kg] (accelerations ``1000 F / M`` [mm/s
 
 import dataclasses
 import math
-import sys
 from typing import NamedTuple
 
 import numpy as np

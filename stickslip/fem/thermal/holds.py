@@ -47,7 +47,7 @@ def hold_trial(system, state, hold_time, below, replica):
     system : stickslip.fem.system.System
         Of a thermal run, with its linear response set.
     state : tuple
-        ``(u, target, lever_target, t)`` of a stored increment (:meth:`..output.RunFile.state`).
+        ``(u, target, lever_target, t)`` of a stored increment (:meth:`stickslip.formats.fem_run.RunFile.state`).
     hold_time : float
         Duration of the hold [time].
     below : float

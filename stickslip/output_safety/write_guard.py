@@ -8,7 +8,7 @@ are kept in memory instead (reads see them, so HDF5 can finish and close the fil
 and the writer checks :attr:`WriteGuard.error` (:func:`stickslip.h5io.open_file` does,
 on every flush and on closing). What is kept after a failure is
 bounded (:data:`KEEP_LIMIT`); a write beyond it is passed to HDF5 as an error at once.
-The file written is then incomplete: :func:`stickslip.h5io.atomic_output` removes it.
+The file written is then incomplete: :func:`stickslip.output_safety.atomic.atomic_output` removes it.
 """
 
 import os

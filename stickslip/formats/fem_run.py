@@ -1,18 +1,24 @@
 """The ``fem-run`` format: layout, writing a run increment by increment, reading it back.
 
-The writer works on arrays and tables (no solver object), so any solver that produces
-this format writes it through here. One HDF5 file per run (written with
-:mod:`stickslip.h5io`, so equal runs give equal bytes):
+The format belongs to no solver: its writer works on arrays, tables and a header
+mapping, and its readers return arrays, tables and plain values, so any producer
+(the ``fem`` solver, another solver, another backend) writes a file that every
+consumer reads. The producer's parameters are stored as opaque JSON (``params``):
+the format never interprets them; what the analyses need is a typed header field
+(:data:`HEADER`). One HDF5 file per run (written with :mod:`stickslip.h5io`, so
+equal runs give equal bytes):
 
 ``/`` attributes
-    ``format`` ("fem-run"), ``format_version``, ``solver`` and ``solver_version`` (the
-    plugin that wrote it), ``version`` (package), ``params`` (JSON of all :class:`FemParams`),
-    the main parameters again as typed attributes (``N``, ``plates``, ``n_interfaces``,
-    ``k_drive``, ``drive``, ``seed``, ``nchunk``), normalisation (``eps0``, ``sig0``,
-    ``gamma0`` [deg], ``c_s``, ``h``, ``dt``, ``alpha``, ``H``), the rigidity ratio ``phi``
-    and the driving ``regime`` ("stiff" or "compliant", :mod:`.stiffness`), ``nstored``
-    (complete increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or
-    "max_increments").
+    ``format`` ("fem-run"), ``format_version``, the producer's header: every field
+    of :data:`HEADER` (``solver``, ``solver_version``,
+    ``params``, ``N``, ``plates``, ``n_interfaces``, ``k_drive``, ``seed``, the
+    normalisation ``eps0``, ``sig0``, ``gamma0`` [deg], ``c_s``, ``h``, ``dt``, the
+    rigidity ratio ``phi`` and the driving ``regime``) and any further attributes of
+    the producer (``fem``: ``drive``, ``nchunk``, ``alpha``, ``H``; a thermal ``fem`` run also
+    ``protocol`` = "thermal", ``temperature``, ``attempt_rate``, ``drive_rate``, ``hold_times``,
+    ``hold_delay``, ``energy_unit``: docs/fem.md, "Finite temperature"); then ``version``
+    (package), ``nstored`` (complete increments) and ``completed`` (bool) with
+    ``stop_reason`` ("margin" or "max_increments").
 ``/mesh``
     The layered mesh (:func:`stickslip.mesh.save_mesh`); with it the run's own interface
     <-> layer map (``interface_elements``, ``elem_layer``; :func:`stickslip.mesh.interface_layer`).
@@ -25,27 +31,71 @@ this format writes it through here. One HDF5 file per run (written with
 ``/increments``
     The observables table (one 1-D dataset per column, attribute ``columns``,
     readable by :func:`stickslip.h5io.read_table`): ``increment``, ``kick``,
-    ``yield_element`` and :func:`.observables.observable_columns`.
+    ``yield_element`` and the producer's observables (``fem``:
+    :func:`stickslip.fem.observables.observable_columns`; a thermal run adds ``hop_block``,
+    ``hop_direction``, ``failed_hops`` (integers) and ``held``); columns ``S_*`` and ``A_*``
+    are integers, the others floats unless the producer types them (``create_file``'s ``dtypes``).
+
+``phi`` and ``regime`` are the producer's (``fem``: :mod:`stickslip.fem.stiffness`);
+consumers read them from here and never recompute them.
 """
 
 import json
+import numbers
 
 import numpy as np
 
 from .. import __version__, formats
-from ..h5io import (FileFormatError, atomic_output, copy_file, open_file, read_array, read_table, write_attrs,
-                    write_dataset)
+from ..h5io import FileFormatError, copy_file, open_file, read_array, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
-from ..params import parse_params
-from .parameters import FemParams
+from ..output_safety.atomic import atomic_output
 
-__all__ = ["FORMAT", "create_file", "append_increment", "rewrite", "read_increments", "read_run_attrs", "read_params",
-           "RunFile", "describe"]
+__all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
+           "read_increments", "read_run_attrs", "RunFile", "describe"]
 
 #: The format name of these files (:mod:`stickslip.formats`).
 FORMAT = "fem-run"
 
+#: Driving regimes a file may state.
+REGIMES = ("stiff", "compliant")
+
+#: Typed root attributes every file holds: name -> (kind, meaning). Kinds: ``int``, ``float``,
+#: ``str``, ``json`` (a mapping, stored as JSON text).
+HEADER = {
+    "solver": ("str", "the producing solver plugin"),
+    "solver_version": ("str", "its algorithm version"),
+    "params": ("json", "the producer's parameters, opaque to the format"),
+    "N": ("int", "blocks per interface"),
+    "plates": ("int", "elastic plates"),
+    "n_interfaces": ("int", "interfaces, plates - 1"),
+    "k_drive": ("float", "drive spring stiffness per unit volume [G/h^2]"),
+    "seed": ("int", "realisation id"),
+    "eps0": ("float", "strain unit of the observables"),
+    "sig0": ("float", "stress unit of the observables"),
+    "gamma0": ("float", "unit of the lever rotation gamma [deg]"),
+    "c_s": ("float", "shear-wave speed [FE length / FE time]"),
+    "h": ("float", "block size [FE length]"),
+    "dt": ("float", "time step [FE time]"),
+    "phi": ("float", "rigidity ratio Phi = K / K_s of the drive"),
+    "regime": ("str", "driving regime, one of REGIMES"),
+}
+
+_KINDS = {"int": (numbers.Integral,), "float": (numbers.Real,), "str": (str,), "json": (dict,)}
+
 _STATE = ("u", "target", "lever_target", "t")
+
+
+def _check_header(header):
+    """Raise ValueError naming every field of :data:`HEADER` that ``header`` lacks or mistypes."""
+    missing = [name for name in HEADER if name not in header]
+    if missing:
+        raise ValueError(f"fem-run header lacks {', '.join(missing)}")
+    wrong = [f"{name} ({HEADER[name][0]}, got {type(header[name]).__name__})" for name in HEADER
+             if not isinstance(header[name], _KINDS[HEADER[name][0]]) or isinstance(header[name], bool)]
+    if wrong:
+        raise ValueError(f"fem-run header: wrong type of {', '.join(wrong)}")
+    if header["regime"] not in REGIMES:
+        raise ValueError(f"fem-run header: regime must be one of {', '.join(REGIMES)}, got {header['regime']!r}")
 
 
 def create_file(file, header, mesh, linear_response, columns, dtypes=None):
@@ -56,8 +106,8 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None):
     file : h5py.File
         Open for writing, empty.
     header : Mapping[str, object]
-        Root attributes: ``solver``, ``solver_version``, ``params`` (dict of :class:`FemParams`),
-        the typed parameters, normalisation, ``phi`` and ``regime`` of the module docstring.
+        Root attributes: every field of :data:`HEADER` (``params`` a JSON-able mapping) and any
+        further attributes of the producer, written in the mapping's order.
     mesh : stickslip.mesh.LayeredMesh
     linear_response : tuple
         ``(delta_u [ndof], delta_eps [ni, 4, 3], delta_target [nlayer], delta_lever)``.
@@ -65,7 +115,13 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None):
         Columns of the observables table after ``increment``, ``kick``, ``yield_element``.
     dtypes : Mapping[str, numpy.dtype], optional
         Types of columns that are neither float64 nor the well counts ``S_*``, ``A_*`` (int64).
+
+    Raises
+    ------
+    ValueError
+        If a field of :data:`HEADER` is missing or of another kind.
     """
+    _check_header(header)
     formats.stamp(file, FORMAT)
     write_attrs(file, {**header, "version": __version__, "nstored": 0, "completed": False, "stop_reason": ""})
     save_mesh(mesh, file.create_group("mesh"))
@@ -143,16 +199,35 @@ def rewrite(path, **attrs):
             write_attrs(target, attrs)
 
 
+def _check(file):
+    """Raise unless ``file`` is a ``fem-run`` file of the current version with every :data:`HEADER` field."""
+    formats.check(file, FORMAT)
+    missing = [name for name in HEADER if name not in file.attrs]
+    if missing:
+        raise FileFormatError(f"{file.filename}: fem-run header lacks {', '.join(missing)}")
+
+
 def read_params(file):
-    """The :class:`FemParams` of an open simulation file.
+    """The producer's parameters stored in an open ``fem-run`` file, as they were written.
+
+    The format does not interpret them: the producer parses them (``fem``:
+    :func:`stickslip.fem.parameters.stored_params`).
+
+    Parameters
+    ----------
+    file : h5py.File
+
+    Returns
+    -------
+    dict
 
     Raises
     ------
     FileFormatError
         If the file is not a ``fem-run`` file of the current version.
     """
-    formats.check(file, FORMAT)
-    return parse_params(FemParams, json.loads(file.attrs["params"]), owner=f"{file.filename}: params")
+    _check(file)
+    return json.loads(file.attrs["params"])
 
 
 class RunFile:
@@ -161,7 +236,20 @@ class RunFile:
     Parameters
     ----------
     file : h5py.File
-        Open simulation file.
+        Open ``fem-run`` file.
+
+    Attributes
+    ----------
+    params : dict
+        The producer's parameters (:func:`read_params`).
+    mesh : stickslip.mesh.LayeredMesh
+    nstored : int
+        Complete increments.
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not a ``fem-run`` file of the current version.
     """
 
     def __init__(self, file):
@@ -177,6 +265,10 @@ class RunFile:
                                   f"(0 ... {self.nstored - 1})")
         u, target, lever_target, t = (read_array(self.file["state"][name], increment) for name in _STATE)
         return u, target, float(lever_target), float(t)
+
+    def increments(self):
+        """The observables table of the stored increments (pandas.DataFrame, :func:`read_increments`)."""
+        return read_table(self.file, "increments", rows=self.nstored)
 
     def increment_bytes(self):
         """Bytes that appending one increment may allocate at most: one new chunk of every growing dataset [B]."""
@@ -197,33 +289,47 @@ def read_increments(path):
 
     Parameters
     ----------
-    path : str or pathlib.Path
+    path : str or os.PathLike
 
     Returns
     -------
     pandas.DataFrame
-        One row per stored increment; columns ``increment``, ``kick``, ``yield_element``, ``t``,
-        ``gamma``, ``epsd``, ``sigd``, ``epsd_<l>``, ``sigd_<l>``, ``ubar_<l>``, ``fxdrive_<l>``,
-        ``S_a<a>``, ``A_a<a>``; free lever also ``lever_target``, ``lever_position``
-        (see :mod:`.observables`).
+        One row per stored increment; columns ``increment``, ``kick``, ``yield_element`` and
+        the producer's observables (``fem``: ``t``, ``gamma``, ``epsd``, ``sigd``, ``epsd_<l>``,
+        ``sigd_<l>``, ``ubar_<l>``, ``fxdrive_<l>``, ``S_a<a>``, ``A_a<a>``; free lever also
+        ``lever_target``, ``lever_position``; :mod:`stickslip.fem.observables`).
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not a ``fem-run`` file of the current version.
     """
     with open_file(path) as file:
-        read_params(file)
+        _check(file)
         return read_table(file, "increments", rows=int(file.attrs["nstored"]))
 
 
 def read_run_attrs(path):
-    """Parameters, normalisation and status of a simulation file.
+    """Header and status of a simulation file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
 
     Returns
     -------
     dict
-        ``N``, ``plates``, ``n_interfaces``, ``k_drive``, ``drive``, ``seed``, ``nchunk``,
-        ``completed``, ``stop_reason``, ``nstored``, ``eps0``, ``sig0``, ``gamma0``, ``c_s``,
-        ``h``, ``dt``, ``alpha``, ``H``, ``version``, ``params`` (dict).
+        Every root attribute as a Python value: the fields of :data:`HEADER` (``params`` decoded
+        to a dict), the producer's further attributes, ``version``, ``nstored``, ``completed``
+        (bool), ``stop_reason``, ``format``, ``format_version``.
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not a ``fem-run`` file of the current version.
     """
     with open_file(path) as file:
-        read_params(file)
+        _check(file)
         out = {}
         for key, value in file.attrs.items():
             out[key] = value.item() if isinstance(value, np.generic) else value
@@ -238,9 +344,9 @@ def describe(path):
     Returns
     -------
     dict[str, object]
-        ``n`` (interfaces), ``plates``, ``blocks`` (N), ``k_drive``, ``phi`` and ``regime``
-        (the file's own attributes, :mod:`.stiffness`), ``seed``, ``temperature`` (0: athermal), and
-        for a thermal run ``attempt_rate`` and ``drive_rate`` (None for an athermal one).
+        ``n`` (interfaces), ``plates``, ``blocks`` (N), ``k_drive``, ``phi``, ``regime``, ``seed``:
+        the file's own header; ``temperature`` (a thermal producer's attribute; 0 for a file without it,
+        the athermal protocol), and for a thermal run ``attempt_rate`` and ``drive_rate`` (None otherwise).
     """
     attrs = read_run_attrs(path)
     thermal = attrs.get("protocol") == "thermal"

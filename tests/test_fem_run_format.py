@@ -1,0 +1,116 @@
+"""The ``fem-run`` format without the solver: a producer with its own parameters writes, the readers read back.
+
+The format stores the producer's parameters as opaque JSON and the header fields the analyses
+need as typed attributes; the analyses read it without loading any module of ``stickslip.fem``.
+"""
+
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from stickslip import formats
+from stickslip.formats import fem_run
+from stickslip.h5io import FileFormatError, open_file
+from stickslip.mesh import MeshParams, build_stack_mesh
+
+#: A producer that is not the ``fem`` solver: parameters the format never interprets.
+HEADER = {"solver": "other-solver", "solver_version": "7", "params": {"grid": [3, 3], "law": "smooth"},
+          "N": 9, "plates": 2, "n_interfaces": 1, "k_drive": 0.5, "seed": 3, "eps0": 1e-3, "sig0": 2e-3,
+          "gamma0": 0.25, "c_s": 0.7, "h": np.pi, "dt": 0.01, "phi": 5e-7, "regime": "compliant",
+          "backend": "gpu-like"}
+
+
+def _write(path, header=HEADER, increments=3):
+    mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+    ndof, nlayer, ni = mesh.ndof, mesh.nlayer, mesh.interface_elements.size
+    rng = np.random.default_rng(0)
+    response = (rng.random(ndof), rng.random((ni, 4, 3)), rng.random(nlayer), 0.5)
+    with open_file(path, "w") as file:
+        fem_run.create_file(file, header, mesh, response, ["t", "sigd", "S_a1", "A_a1"])
+        for i in range(increments):
+            state = (np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i)
+            fem_run.append_increment(file, state, {"increment": i, "kick": i % 2 == 0, "yield_element": False,
+                                                   "t": 0.1 * i, "sigd": 1.5 * i, "S_a1": i, "A_a1": 9 * i})
+    return mesh, response
+
+
+def test_a_producer_with_other_parameters_writes_a_readable_file(tmp_path):
+    path = tmp_path / "run.h5"
+    mesh, response = _write(path)
+    attrs = fem_run.read_run_attrs(path)
+    assert attrs["params"] == HEADER["params"]  # stored as written, not parsed
+    assert (attrs["solver"], attrs["backend"], attrs["phi"], attrs["regime"]) == ("other-solver", "gpu-like", 5e-7,
+                                                                                "compliant")
+    assert attrs["nstored"] == 3 and attrs["completed"] is False and attrs["format"] == "fem-run"
+    table = fem_run.read_increments(path)
+    assert list(table.columns) == ["increment", "kick", "yield_element", "t", "sigd", "S_a1", "A_a1"]
+    np.testing.assert_array_equal(table["sigd"], [0.0, 1.5, 3.0])
+    assert table["A_a1"].dtype == np.int64 and table["kick"].tolist() == [True, False, True]
+    with open_file(path) as file:
+        run = fem_run.RunFile(file)
+        assert run.params == HEADER["params"] and run.nstored == 3 and run.mesh.N == 9
+        u, target, lever, t = run.state(2)
+        np.testing.assert_array_equal(u, np.full(mesh.ndof, 2.0))
+        assert (lever, t) == (6.0, pytest.approx(0.2))
+        stored = run.linear_response()
+        for got, expected in zip(stored, response):
+            np.testing.assert_array_equal(got, expected)
+        with pytest.raises(FileFormatError, match="increment 3 is not stored"):
+            run.state(3)
+    assert formats.describe("fem-run", path) == {"n": 1, "plates": 2, "blocks": 9, "k_drive": 0.5, "phi": 5e-7,
+                                                  "regime": "compliant", "seed": 3}
+
+
+def test_rows_beyond_nstored_are_dropped_by_rewrite(tmp_path):
+    path = tmp_path / "run.h5"
+    _write(path)
+    with h5py.File(path, "r+") as file:
+        file.attrs["nstored"] = 2  # as if the third increment was being written when the writer was killed
+    fem_run.rewrite(path, completed=True, stop_reason="margin")
+    attrs = fem_run.read_run_attrs(path)
+    assert (attrs["nstored"], attrs["completed"], attrs["stop_reason"]) == (2, True, "margin")
+    assert len(fem_run.read_increments(path)) == 2
+    with h5py.File(path) as file:
+        assert file["state/u"].shape[0] == 2
+
+
+def test_the_writer_names_missing_or_mistyped_header_fields(tmp_path):
+    without = {key: value for key, value in HEADER.items() if key not in ("phi", "c_s")}
+    with pytest.raises(ValueError, match="lacks c_s, phi"):
+        _write(tmp_path / "a.h5", without)
+    with pytest.raises(ValueError, match=r"N \(int, got str\)"):
+        _write(tmp_path / "b.h5", {**HEADER, "N": "9"})
+    with pytest.raises(ValueError, match="regime must be one of stiff, compliant"):
+        _write(tmp_path / "c.h5", {**HEADER, "regime": "soft"})
+
+
+def test_the_readers_refuse_a_file_without_a_header_field_or_of_another_format(tmp_path):
+    path = tmp_path / "run.h5"
+    _write(path)
+    with h5py.File(path, "r+") as file:
+        del file.attrs["regime"]
+    for read in (fem_run.read_run_attrs, fem_run.read_increments):
+        with pytest.raises(FileFormatError, match="run.h5: fem-run header lacks regime"):
+            read(path)
+    with h5py.File(path, "r+") as file:
+        file.attrs["format"] = "timeseries"
+    with pytest.raises(FileFormatError, match="a timeseries file version 1, expected fem-run"):
+        fem_run.read_run_attrs(path)
+
+
+def test_the_analyses_load_no_module_of_the_solver():
+    # every module of stickslip.events and the experimental analysis, in a fresh interpreter
+    probe = ("import importlib, pkgutil, sys\n"
+             "import stickslip.events\n"
+             "for module in pkgutil.iter_modules(stickslip.events.__path__):\n"
+             "    importlib.import_module('stickslip.events.' + module.name)\n"
+             "import stickslip.experiment.analysis\n"
+             "print(sorted(m for m in sys.modules if m == 'stickslip.fem' or m.startswith('stickslip.fem.')))\n"
+             "print(len([m for m in sys.modules if m.startswith('stickslip.events.')]))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    loaded, events = done.stdout.split("\n")[:2]
+    assert loaded == "[]"
+    assert int(events) >= 6  # the probe did import the analyses
