@@ -75,7 +75,7 @@ def load_runs(paths):
     """
     rows = []
     for path in sorted(map(str, paths)):
-        item = read_analysis_file(path, _TABLES)
+        item = read_analysis_file(path, "event-table", _TABLES)
         thermal = bool(item.attrs.get("thermal", False))
         params = item.attrs.get("params", {})
         rows.append({"file": path, "thermal": thermal, "n": item.n,
