@@ -13,9 +13,9 @@ Built-in formats (``docs/developing.md`` draws the data flow):
 format         reader/writer                            producers -> consumers
 =============  =======================================  ========================================
 mesh           :mod:`stickslip.mesh.io`                 mesh stage -> ``fem`` (solver input), figS-mesh
-fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics
+fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics, thermal-events
 timeseries     :mod:`stickslip.experiment.timeseries`   ``lever``, lab CSV import -> experiment-events
-event-table    :mod:`stickslip.formats.event_table`     numerical-events, experiment-events -> figures, database
+event-table    :mod:`stickslip.formats.event_table`     numerical-, experiment-, thermal-events -> figures, database
 front-table    :mod:`stickslip.formats.front_table`     front-dynamics -> figS-event-maps, figS-tau
 =============  =======================================  ========================================
 
