@@ -147,3 +147,31 @@ def test_ingest_reads_lineage_and_formats_not_paths(tmp_path, toy_plugins, monke
     with pytest.raises(FileFormatError, match="a fem-run file; analysis 'toy-slips' reads toy-block"):
         wrong = Artifact("anything/first.h5", run, "fem", "fem-run")
         run_analysis(analysis.name, "{}", Study.dumps(wrong), "x.h5", "x.provenance.json", "log3")
+
+
+def test_the_periodicity_of_a_numerical_run_goes_to_its_table_and_view(tmp_path, monkeypatch):
+    """An event file's one-row ``periodicity`` table -> ``run_periodicity``; the view adds the simulation's columns."""
+    from stickslip.events.plugin import NAME, VERSION, event_attrs, event_tables, write_event_file
+    from stickslip.provenance.record import recording
+    from test_events_extraction import EVENTS, N, history, run_attrs
+
+    monkeypatch.chdir(tmp_path)
+    simulation = Artifact("sim/abc.h5", "0123456789abcdef", "fem", "fem-run")
+    simulation.path.parent.mkdir()
+    simulation.path.write_bytes(b"a stand-in for the run file")
+    tables = event_tables(history(N, EVENTS), N)
+    with recording("events/abc.provenance.json", [("output", "events/abc.h5", "event-table")], run_id="fedcba9876543210",
+                   kind="analysis", plugin=NAME, plugin_version=VERSION, code_hash="x", params={},
+                   inputs=[("simulation", simulation)]):
+        write_event_file(tables, event_attrs(run_attrs(N, 3, 1e-3), tables["increments"]),
+                         "events/abc.h5", input=simulation.path)
+    ingest("db.sqlite", ["events/abc.provenance.json"])
+    row = query.sql("SELECT * FROM periodicity_full", "db.sqlite")
+    expected = tables["periodicity"].iloc[0]
+    assert len(row) == 1 and row["simulation_run_id"].iloc[0] == "0123456789abcdef"
+    assert row["slips"].iloc[0] == expected["slips"] and row["multi"].iloc[0] == expected["multi"]
+    assert row["interval_cv"].iloc[0] == pytest.approx(expected["interval_cv"])
+    assert row["alternation_cv"].isna().iloc[0] == np.isnan(expected["alternation_cv"])  # NaN is NULL
+    assert row["phi"].isna().iloc[0]  # the simulation itself was not ingested: its columns are NULL
+    ingest("db.sqlite", ["events/abc.provenance.json"])  # idempotent
+    assert len(query.sql("SELECT * FROM run_periodicity", "db.sqlite")) == 1

@@ -47,10 +47,10 @@ def test_the_reader_refuses_other_files_and_names_what_is_missing(tmp_path):
     _write(tmp_path / "fronts.h5")
     with h5py.File(tmp_path / "fronts.h5", "r+") as file:
         file.attrs["format_version"] = 0
-    with pytest.raises(FileFormatError, match="version 0, expected front-table version 1"):
+    with pytest.raises(FileFormatError, match="version 0, expected front-table version 2"):
         front_table.read_front_tables(tmp_path / "fronts.h5")
     with h5py.File(tmp_path / "fronts.h5", "r+") as file:
-        file.attrs["format_version"] = 1
+        file.attrs["format_version"] = 2
         write_table(file, "fronts", read_table(file, "fronts").drop(columns="tau"))
     with pytest.raises(FileFormatError, match="table 'fronts' lacks column"):
         front_table.read_front_tables(tmp_path / "fronts.h5")

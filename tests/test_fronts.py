@@ -42,24 +42,80 @@ def rupture(N, a, *, c_f, nucleation, start, rng, jitter=0.0, nucleation_extent=
     })
 
 
+C_D = fronts.p_wave_speed(4.5, 1.0, 1.0)  # the paper's K = 4.5 G: 2.35 c_s
+
+
+def test_p_wave_speed_of_the_plane_model():
+    assert C_D / C_S == pytest.approx(np.sqrt(5.5))
+
+
 def test_front_speed_of_a_clean_front_is_exact():
     N = 162
     failures = rupture(N, 1, c_f=2.0, nucleation=3, start=0.0, rng=np.random.default_rng(0))
     fit = fronts.front_fit(failures, 1, N)
-    assert fit["nucleation"] == 3
-    assert fit["speed"] * H_BLOCK / C_S == pytest.approx(2.0, rel=1e-10)
-    assert fit["points"] == 2 * (int(0.9 * N / 2) - int(np.ceil(0.3 * N / 2)) + 1)
-    # the fitted front leaves the nucleation block when the patch would have been crossed at c_f
-    patch = 0.15 * N / 2
-    assert fit["t0"] == pytest.approx(30.0 - patch * H_BLOCK / (2.0 * C_S), rel=1e-10)
+    assert fit["nucleation"] == 3 and fit["meeting"] in (83, 84)  # the antipode: 81 blocks either way
+    for side in fronts.BRANCHES:
+        branch = fit[side]
+        assert branch["speed"] * H_BLOCK / C_S == pytest.approx(2.0, rel=1e-10)
+        assert branch["quality"] == "ok" and branch["r2"] == pytest.approx(1.0)
+        # the fitted front leaves the nucleation block when the patch would have been crossed at c_f
+        patch = 0.15 * N / 2
+        assert branch["t0"] == pytest.approx(30.0 - patch * H_BLOCK / (2.0 * C_S), rel=1e-10)
+    assert fit["right"]["points"] + fit["left"]["points"] == pytest.approx(2 * 0.6 * N / 2, abs=2)
 
 
 @pytest.mark.parametrize("c_f", [1.0, 2.0, 1.6])
 def test_front_speed_with_noisy_arrivals(c_f):
     N = 486
     failures = rupture(N, 2, c_f=c_f, nucleation=400, start=5.0, rng=np.random.default_rng(1), jitter=2.0)
-    fit = fronts.front_fit(failures, 2, N)
-    assert fit["speed"] * H_BLOCK / C_S == pytest.approx(c_f, rel=0.02)
+    row = fronts.analyse_event(failures, N, h=H_BLOCK, c_s=C_S, spacing=SPACING, c_d=C_D)
+    assert row["fit"] == "ok" and row["c_f"] == pytest.approx(c_f, rel=0.02)
+    assert row["c_f_left"] == pytest.approx(c_f, rel=0.02) and row["c_f_right"] == pytest.approx(c_f, rel=0.02)
+
+
+def test_two_branches_of_different_speed_and_origin_meet_where_they_arrive_together():
+    """Right branch at 1.8 c_s from block 100, left at 1.2 c_s from block 90, 20 time units later."""
+    N = 486
+    rng = np.random.default_rng(4)
+    blocks = np.arange(N)
+    right, left = np.mod(blocks - 100, N), np.mod(90 - blocks, N)
+    t_right = 10.0 + right * H_BLOCK / (1.8 * C_S)
+    t_left = 30.0 + left * H_BLOCK / (1.2 * C_S)
+    first = np.minimum(t_right, t_left)
+    first[91:100] = rng.uniform(0.0, 8.0, 9)  # the nucleation patch between the two origins
+    first[95] = 0.0
+    first[300] += 500.0  # a block the front passed that failed only much later: not the meeting point
+    first[350] -= 150.0  # a block that failed early by itself, ahead of the front
+    failures = pd.DataFrame({"a": 1, "block": blocks, "t": first, "direction": 1})
+    fit = fronts.front_fit(failures, 1, N, c_max=C_D / H_BLOCK)
+    meeting = int(np.argmax(np.where(np.arange(N) == 300, 0.0, first)))
+    assert fit["nucleation"] == 95 and abs(fit["meeting"] - meeting) <= 1
+    assert fit["right"]["speed"] * H_BLOCK / C_S == pytest.approx(1.8, rel=1e-3)
+    assert fit["left"]["speed"] * H_BLOCK / C_S == pytest.approx(1.2, rel=1e-3)
+    assert fit["right"]["quality"] == fit["left"]["quality"] == "ok"
+
+
+def test_meaningless_fits_are_flagged_and_not_averaged():
+    N = 162
+    # every block fails within one time unit: a "front" of tens of c_s, faster than any wave
+    at_once = pd.DataFrame({"a": 1, "block": np.arange(N), "direction": 1,
+                            "t": np.r_[0.0, np.random.default_rng(5).uniform(0.5, 1.5, N - 1)]})
+    row = fronts.analyse_event(at_once, N, h=H_BLOCK, c_s=C_S, spacing=SPACING, c_d=C_D)
+    assert np.isnan(row["c_f"]) and row["fit"] != "ok"
+    assert {row["quality_left"], row["quality_right"]} <= {"faster than P waves", "not ballistic", "no front"}
+    # a short interface: too few blocks in the fitted window
+    short = rupture(12, 1, c_f=2.0, nucleation=0, start=0.0, rng=np.random.default_rng(6))
+    row = fronts.analyse_event(short, 12, h=H_BLOCK, c_s=C_S, spacing=SPACING, c_d=C_D)
+    assert row["quality_left"] == row["quality_right"] == "few points" and np.isnan(row["c_f"])
+    assert row["fit"] == "right: few points; left: few points"
+    # one good branch at 1.5 c_s, the other no line at all (blocks failing at random): c_f is the good one alone
+    blocks = np.arange(N)
+    right = np.mod(blocks - 40, N)
+    first = np.where(right <= N // 2, right * H_BLOCK / (1.5 * C_S), np.random.default_rng(8).uniform(0, 150, N))
+    failures = pd.DataFrame({"a": 1, "block": blocks, "t": first, "direction": 1})
+    row = fronts.analyse_event(failures, N, h=H_BLOCK, c_s=C_S, spacing=SPACING, c_d=C_D)
+    assert row["quality_right"] == "ok" and row["quality_left"] != "ok" and row["fit"] == "ok"
+    assert row["c_f"] == row["c_f_right"] == pytest.approx(1.5, rel=1e-6)
 
 
 def test_delay_between_first_and_second_slipping_interface():
@@ -73,6 +129,7 @@ def test_delay_between_first_and_second_slipping_interface():
     assert fronts.slipping_interfaces(failures, N) == [(2, 3.0), (1, 3.0 + tau)]
     row = fronts.analyse_event(failures, N, h=H_BLOCK, c_s=C_S, spacing=SPACING)
     assert (row["s"], row["a_first"], row["a_second"], row["nucleation"]) == (2, 2, 1, 10)
+    assert row["fit"] == "ok"
     assert row["tau"] == pytest.approx(tau * C_S / SPACING, rel=1e-12)
     assert row["c_f"] == pytest.approx(2.0, rel=1e-10)
     assert row["t_first"] == 1.0

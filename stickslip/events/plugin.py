@@ -13,7 +13,9 @@ tables as in :func:`stickslip.h5io.write_table`):
 ``slip_interfaces``
     one row per (slip event, slipping interface) (:func:`~stickslip.events.extraction.slip_interfaces`);
 ``sequences``
-    runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`).
+    runs of consecutive single- or multi-slip events (:func:`~stickslip.events.extraction.slip_sequences`);
+``periodicity``
+    one row: the run's periodicity and synchronisation measures (:mod:`stickslip.events.periodicity`).
 
 Root attributes: every attribute of the run (N, plates, n_interfaces, k_drive, seed, ...),
 with the run's ``phi`` (the rigidity ratio Phi) and ``regime`` ("stiff" or "compliant") as the run file
@@ -31,12 +33,12 @@ from ..formats.event_table import slip_events_table
 from ..formats.fem_run import read_increments, read_run_attrs
 from ..h5io import FileFormatError
 from ..registry import register
-from . import extraction
+from . import extraction, periodicity
 
 __all__ = ["EventParams", "NAME", "VERSION", "event_tables", "numerical_slip_events", "event_attrs", "write_event_file", "run"]
 
 NAME = "numerical-events"
-VERSION = "1"
+VERSION = "2"  # 2: the table "periodicity"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,7 +47,7 @@ class EventParams:
 
 
 def event_tables(increments, N, *, source="increment table"):
-    """Return the four event tables of one run.
+    """Return the event tables of one run.
 
     Parameters
     ----------
@@ -59,7 +61,8 @@ def event_tables(increments, N, *, source="increment table"):
     Returns
     -------
     dict[str, pandas.DataFrame]
-        ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``.
+        ``increments``, ``slips``, ``slip_interfaces``, ``sequences``, ``slip_events``,
+        ``periodicity`` (:func:`stickslip.events.periodicity.periodicity_table`).
     """
     classified = extraction.classify_increments(increments, N, source=source)
     slips = extraction.steady_slips(classified, N)
@@ -70,6 +73,7 @@ def event_tables(increments, N, *, source="increment table"):
         "slip_interfaces": per_interface,
         "sequences": extraction.slip_sequences(slips),
         "slip_events": numerical_slip_events(per_interface),
+        periodicity.TABLE: periodicity.periodicity_table(slips, len(extraction.interfaces_in(classified))),
     }
 
 

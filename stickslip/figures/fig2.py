@@ -7,7 +7,12 @@ interface, multi-slip drops black. (c) rho(s), the fraction of slip events invol
 interfaces, for every n: stiff dashed, compliant solid. (f) Density of the stress drop
 Delta mu_a [sig0] of the slipping interface in single-slip events, compliant driving, every n,
 with Welch's test of equal means between the smallest and the largest n and the shift it
-would detect (:mod:`stickslip.events.mean_shift`).
+would detect (:mod:`stickslip.events.mean_shift`), beside the paper's finding (no shift).
+Beyond the paper's figure (:mod:`stickslip.events.periodicity`), against n, stiff dashed and
+compliant solid, mean over the runs (seeds) with one standard error: (g) periodicity, the
+coefficient of variation of the shear increment Delta gamma between consecutive slip events
+(0: periodic, 1: Poisson) and of the stress drops Delta Sigma; (h) synchronisation, the
+fraction of slip events in which all n interfaces slip and the multi-slip fraction rho(s > 1).
 Runs at the paper's Phi (5e-4 stiff, 5e-7 compliant) are pooled by (regime, n) over seeds; the
 panel texts give N, Phi and the number of events.
 """
@@ -22,6 +27,7 @@ from ..events.mean_shift import shift_test
 from ..params import param
 from ..registry import register
 from .numerical_common import REGIME_LINESTYLE, read_inputs, run_phi
+from .periodicity_panels import MEASURE_LABEL, MEASURE_MARKER, periodicity_summary, plot_measure
 from .plotting import label_panels, n_style, plot_density, range_edges
 from .style import interface_color, plt, save_figure
 
@@ -142,19 +148,52 @@ def _drop_panel(ax, groups, bins):
         test = shift_test(samples[low], samples[high])
         ax.text(0.98, 0.55, f"$n = {high}$ vs ${low}$: mean {100 * test['shift']:+.0f} %\n"
                 f"Welch $p = {test['p_value']:.2g}$\n"
-                f"detectable: {100 * test['detectable_shift']:.0f} %", transform=ax.transAxes,
+                f"detectable: {100 * test['detectable_shift']:.0f} %\n"
+                "paper ($N = 1458$): no $n$ dependence", transform=ax.transAxes,
                 ha="right", va="top", fontsize=6)
 
 
-@register("figure", NAME, "3", Fig2Params, inputs=("analysis:numerical-events",))
+def _periodicity_panels(ax_periodic, ax_sync, files):
+    """(g) CV of Delta gamma and of Delta Sigma, (h) system-spanning and multi-slip fractions, against n."""
+    summary = periodicity_summary(files, {"regime": lambda f: f.regime, "n": lambda f: f.n})
+    for ax, measures in ((ax_periodic, ("interval_cv", "drop_cv")), (ax_sync, ("spanning_fraction", "multi_fraction"))):
+        for (regime,), rows in summary.groupby(["regime"]):
+            rows = rows.sort_values("n")
+            for measure, color in zip(measures, ("k", "0.55")):
+                plot_measure(ax, rows, "n", measure, color=color, ls=REGIME_LINESTYLE[regime],
+                             marker=MEASURE_MARKER[measure], markerfacecolor="white" if regime == "stiff" else color)
+        for measure, color in zip(measures, ("k", "0.55")):
+            ax.plot([], [], color=color, marker=MEASURE_MARKER[measure], ms=4, ls="none", label=MEASURE_LABEL[measure])
+        ax.set_xlabel("$n$")
+        ax.xaxis.get_major_locator().set_params(integer=True)
+        ax.legend(fontsize=6, frameon=False, loc="upper right")
+    runs = ", ".join(f"{regime} {int(rows['runs'].max())}" for (regime,), rows in summary.groupby(["regime"]))
+    box = {"facecolor": "white", "alpha": 0.8, "lw": 0}
+    ax_periodic.axhline(1.0, color="0.7", lw=0.6, ls=":")
+    ax_periodic.set_ylim(bottom=0)
+    ax_periodic.set_ylabel("coefficient of variation")
+    ax_periodic.set_title("periodicity", fontsize=9)
+    ax_periodic.text(0.02, 0.03, f"0: periodic, 1: Poisson; runs (seeds) per point: {runs}\n"
+                     "paper: stiff periodic, compliant less periodic", transform=ax_periodic.transAxes, fontsize=6,
+                     bbox=box)
+    ax_sync.set_ylim(-0.02, 1.02)
+    ax_sync.set_ylabel("fraction of slip events")
+    ax_sync.set_title("synchronisation", fontsize=9)
+    ax_sync.text(0.02, 0.5, "paper: stiff slips involve all layers", transform=ax_sync.transAxes, fontsize=6,
+                 bbox=box)
+
+
+@register("figure", NAME, "4", Fig2Params, inputs=("analysis:numerical-events",))
 def run(params, inputs, output):
-    """Fig. 2: Sigma(gamma) stiff and compliant, rho(s) for every n, P(Delta mu_a) compliant."""
-    files = read_inputs(inputs, "analysis:numerical-events", ("increments", "slips", "slip_interfaces"), NAME)
+    """Fig. 2: Sigma(gamma) stiff and compliant, rho(s), P(Delta mu_a) compliant; periodicity and synchronisation."""
+    files = read_inputs(inputs, "analysis:numerical-events", ("increments", "slips", "slip_interfaces", "periodicity"),
+                        NAME)
     groups = group_runs(files)
-    fig, axes = plt.subplots(2, 2, figsize=(7.0, 5.6), constrained_layout=True)
+    fig, axes = plt.subplots(3, 2, figsize=(7.0, 8.4), constrained_layout=True)
     _trace_panel(axes[0, 0], groups, "stiff", params.n_trace, params.slips_shown)
     _trace_panel(axes[0, 1], groups, "compliant", params.n_trace, params.slips_shown)
     _rho_panel(axes[1, 0], groups)
     _drop_panel(axes[1, 1], groups, params.bins)
-    label_panels(axes, "abcf")
+    _periodicity_panels(axes[2, 0], axes[2, 1], files)
+    label_panels(axes, "abcfgh")
     save_figure(fig, output)

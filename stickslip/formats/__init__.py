@@ -210,6 +210,6 @@ for _builtin in (
                describe="stickslip.experiment.timeseries:describe", unstamped=1),
         Format("event-table", 1, "stickslip.formats.event_table", "slip events: one row per (event, slipping "
                "interface) in the table 'slip_events', plus the analysis's own tables"),
-        Format("front-table", 1, "stickslip.formats.front_table", "re-run events: block failures and rupture fronts"),
+        Format("front-table", 2, "stickslip.formats.front_table", "re-run events: block failures and rupture fronts"),
 ):
     register_format(_builtin)

@@ -6,6 +6,10 @@ the results database ingests it as it is, followed by any further numeric or boo
 columns of the analysis (the database keeps them as JSON in ``extra``); the analysis may
 add tables of its own beside it. Numerical (``numerical-events``) and experimental
 (``experiment-events``) analyses both produce it.
+
+An optional one-row table ``periodicity`` (:data:`PERIODICITY_COLUMNS`) holds the periodicity
+and synchronisation measures of the run's slip events (:mod:`stickslip.events.periodicity`);
+the database keeps it in its table ``run_periodicity``.
 """
 
 import numpy as np
@@ -14,7 +18,8 @@ import pandas as pd
 from ..h5io import FileFormatError, read_table
 from .analysis_file import open_analysis_file
 
-__all__ = ["FORMAT", "TABLE", "COLUMNS", "REQUIRED", "slip_events_table", "read_slip_events"]
+__all__ = ["FORMAT", "TABLE", "COLUMNS", "REQUIRED", "PERIODICITY_TABLE", "PERIODICITY_COLUMNS", "slip_events_table",
+           "read_slip_events", "read_periodicity"]
 
 FORMAT = "event-table"
 
@@ -35,6 +40,23 @@ COLUMNS = {
 
 #: Columns every table has.
 REQUIRED = ("event", "interface", "multi")
+
+#: Name of the optional one-row table of the run's periodicity measures.
+PERIODICITY_TABLE = "periodicity"
+
+#: Its columns: name -> (dtype, meaning); every one is present (NaN where undefined).
+PERIODICITY_COLUMNS = {
+    "slips": ("int64", "steady-state slip events m"),
+    "multi": ("int64", "multi-slips (s > 1)"),
+    "spanning": ("int64", "system-spanning slips (s = n)"),
+    "interval_cv": ("float64", "coefficient of variation of the shear increment between consecutive slip events"),
+    "drop_cv": ("float64", "coefficient of variation of the macroscopic stress drops of the slip events"),
+    "multi_fraction": ("float64", "fraction of slip events that are multi-slips, rho(s > 1)"),
+    "spanning_fraction": ("float64", "fraction of slip events in which every interface slips"),
+    "alternation_cv": ("float64", "coefficient of variation of the number of single slips between consecutive "
+                                  "multi-slips"),
+    "runs_z": ("float64", "Wald-Wolfowitz runs statistic of the order of single and multi slips"),
+}
 
 
 def slip_events_table(table, source="slip table"):
@@ -90,3 +112,30 @@ def read_slip_events(path):
     with open_analysis_file(path, FORMAT) as file:
         table = read_table(file, TABLE)
     return slip_events_table(table, source=str(path))
+
+
+def read_periodicity(path):
+    """Read the optional ``periodicity`` table of an ``event-table`` file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    pandas.DataFrame or None
+        One row, columns :data:`PERIODICITY_COLUMNS`; None if the file has no such table.
+
+    Raises
+    ------
+    FileFormatError
+        If the file is not an ``event-table`` file of the current version, or the table lacks a column.
+    """
+    with open_analysis_file(path, FORMAT) as file:
+        if PERIODICITY_TABLE not in file:
+            return None
+        table = read_table(file, PERIODICITY_TABLE)
+    missing = [c for c in PERIODICITY_COLUMNS if c not in table.columns]
+    if missing:
+        raise FileFormatError(f"{path}: table '{PERIODICITY_TABLE}' lacks column(s) {', '.join(missing)}")
+    return table[list(PERIODICITY_COLUMNS)].astype({c: dtype for c, (dtype, _) in PERIODICITY_COLUMNS.items()})

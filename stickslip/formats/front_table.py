@@ -12,9 +12,14 @@ columns and dtypes below, and the attributes of the run it re-ran (``N``, ``n_in
 ``fronts``
     one row per re-run event: ``increment``, ``s`` (slipping interfaces), ``a_first``,
     ``a_second`` (0 if fewer than two slip), ``nucleation`` (block of the first failure),
-    ``c_f`` (front speed of the first slipping interface [c_s]), ``fit_t0`` [FE time],
-    ``fit_points``, ``t_first`` (first failure [FE time]), ``tau`` (delay between the first
-    failures of the first two slipping interfaces [H / c_s]).
+    ``meeting`` (block both branches of the front reach last), ``c_f`` (front speed of the first
+    slipping interface [c_s]: the mean of the branches whose fit is meaningful, NaN if none),
+    ``fit`` ("ok" or the reasons), per branch ``right`` / ``left``: ``c_f_<b>`` [c_s],
+    ``t0_<b>`` [FE time], ``points_<b>``, ``r2_<b>``, ``quality_<b>`` (text); ``t_first`` (first
+    failure [FE time]), ``tau`` (delay between the first failures of the first two slipping
+    interfaces [H / c_s]). See :func:`stickslip.events.fronts.analyse_event`.
+
+Version 2 (issue 23): the per-branch columns, ``meeting`` and ``fit`` replace ``fit_t0`` and ``fit_points``.
 """
 
 from ..h5io import FileFormatError, read_table
@@ -29,7 +34,11 @@ FAILURE_DTYPES = {"increment": "int64", "a": "int64", "block": "int64", "t": "fl
 
 #: Columns of the table "fronts" (one row per re-run event) and their dtypes.
 FRONT_DTYPES = {"increment": "int64", "s": "int64", "a_first": "int64", "a_second": "int64", "nucleation": "int64",
-                "c_f": "float64", "fit_t0": "float64", "fit_points": "int64", "t_first": "float64", "tau": "float64"}
+                "meeting": "int64", "c_f": "float64", "fit": "object",
+                **{f"{column}_{side}": dtype for side in ("right", "left")
+                   for column, dtype in (("c_f", "float64"), ("t0", "float64"), ("points", "int64"),
+                                         ("r2", "float64"), ("quality", "object"))},
+                "t_first": "float64", "tau": "float64"}
 
 #: The tables of a file and their columns.
 TABLES = {"failures": FAILURE_DTYPES, "fronts": FRONT_DTYPES}

@@ -12,24 +12,28 @@ runs          one row per job (simulation, analysis, figure, mesh): its provenan
 artifacts     every input and output file of every run, with sha256 and size.
 simulations   one row per solver run: typed physics parameters.
 slip_events   one row per slip of one interface in one event (numerical and experimental).
+run_periodicity  one row per analysed run: periodicity and synchronisation of its slip events.
 figures       one row per figure: its PDF and PNG.
 
-View ``slip_events_full``: slip_events joined with the parameters of their simulation.
+Views ``slip_events_full`` and ``periodicity_full``: slip_events and run_periodicity joined with
+the parameters of their simulation.
 """
 
 from sqlalchemy import Boolean, Float, ForeignKey, Index, Integer, String, Text, create_engine, event, text
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
 
+from ..formats.event_table import PERIODICITY_COLUMNS
 from ..h5io import FileFormatError
 
-__all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "ArtifactRow", "Simulation", "SlipEvent", "Figure",
-           "VIEWS", "engine_for", "create_schema"]
+__all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "ArtifactRow", "Simulation", "SlipEvent", "RunPeriodicity",
+           "Figure", "VIEWS", "engine_for", "create_schema"]
 
 #: Version of the table layout; a database of another version must be rebuilt (``stickslip db
 #: rebuild``). 2: ``simulations.phi``; 3: lineage (``artifacts.format``, ``artifacts.made_by``,
-#: ``simulations.format``), ``slip_events`` is the ``event-table`` file's table as it is; 4:
-#: ``simulations.temperature``, ``attempt_rate``, ``drive_rate`` (thermal fem runs).
-SCHEMA_VERSION = 4
+#: ``simulations.format``), ``slip_events`` is the ``event-table`` file's table as it is;
+#: 4: ``run_periodicity`` and the view ``periodicity_full``; 5: ``simulations.temperature``,
+#: ``attempt_rate``, ``drive_rate`` (thermal fem runs).
+SCHEMA_VERSION = 5
 
 
 class Base(DeclarativeBase):
@@ -141,6 +145,26 @@ class SlipEvent(Base):
     extra: Mapped[str | None] = mapped_column(Text, doc="the table's further columns, JSON")
 
 
+class RunPeriodicity(Base):
+    """Periodicity and synchronisation of one run's slip events: the ``periodicity`` table of an
+    ``event-table`` file (:mod:`stickslip.events.periodicity`), one row per analysis run."""
+
+    __tablename__ = "run_periodicity"
+    analysis_run_id: Mapped[str] = mapped_column(ForeignKey("runs.run_id", ondelete="CASCADE"), primary_key=True)
+    simulation_run_id: Mapped[str] = mapped_column(String(16), index=True,
+                                                   doc="run id of the analysed simulation (from the lineage)")
+    analysis: Mapped[str] = mapped_column(String)
+    slips: Mapped[int] = mapped_column(Integer, doc=PERIODICITY_COLUMNS["slips"][1])
+    multi: Mapped[int] = mapped_column(Integer, doc=PERIODICITY_COLUMNS["multi"][1])
+    spanning: Mapped[int] = mapped_column(Integer, doc=PERIODICITY_COLUMNS["spanning"][1])
+    interval_cv: Mapped[float | None] = mapped_column(Float, doc=PERIODICITY_COLUMNS["interval_cv"][1])
+    drop_cv: Mapped[float | None] = mapped_column(Float, doc=PERIODICITY_COLUMNS["drop_cv"][1])
+    multi_fraction: Mapped[float | None] = mapped_column(Float, doc=PERIODICITY_COLUMNS["multi_fraction"][1])
+    spanning_fraction: Mapped[float | None] = mapped_column(Float, doc=PERIODICITY_COLUMNS["spanning_fraction"][1])
+    alternation_cv: Mapped[float | None] = mapped_column(Float, doc=PERIODICITY_COLUMNS["alternation_cv"][1])
+    runs_z: Mapped[float | None] = mapped_column(Float, doc=PERIODICITY_COLUMNS["runs_z"][1])
+
+
 class Figure(Base):
     """One figure file pair."""
 
@@ -158,6 +182,11 @@ VIEWS = {
     "slip_events_full": (
         "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed, s.temperature, "
         "s.attempt_rate, s.drive_rate FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
+    "periodicity_full": (
+        "SELECT p.*, s.solver, s.n, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed, "
+        "json_extract(r.params, '$.dt_scale') AS dt_scale FROM run_periodicity AS p "
+        "LEFT JOIN simulations AS s ON s.run_id = p.simulation_run_id "
+        "LEFT JOIN runs AS r ON r.run_id = p.simulation_run_id"),
 }
 
 

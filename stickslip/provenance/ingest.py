@@ -14,7 +14,8 @@ carry, never file names, and needs no edit for a new solver or analysis:
 - solver records -> ``simulations``: the source of the output's format and the columns its
   format describes (:func:`stickslip.formats.describe`);
 - analysis records whose output is an ``event-table`` -> ``slip_events``, the file's
-  ``slip_events`` table as it is, keyed by the simulation named in the record's lineage;
+  ``slip_events`` table as it is, keyed by the simulation named in the record's lineage, and
+  ``run_periodicity``, its ``periodicity`` table where it has one;
 - figure records -> ``figures``.
 """
 
@@ -32,7 +33,7 @@ from ..formats import event_table
 from ..h5io import FileFormatError
 from ..output_safety.atomic import atomic_output
 from ..progress import iterate
-from .database import ArtifactRow, Figure, Run, Simulation, SlipEvent, create_schema, engine_for
+from .database import ArtifactRow, Figure, Run, RunPeriodicity, Simulation, SlipEvent, create_schema, engine_for
 from .record import read_record
 
 __all__ = ["ingest", "find_records"]
@@ -119,20 +120,26 @@ def _python(value):
 
 
 def _event_rows(record, record_file):
-    """Rows of ``slip_events``: an ``event-table`` output's table, keyed by the record's lineage."""
+    """Rows of ``slip_events`` and of ``run_periodicity`` (a list of 0 or 1) of an ``event-table`` output."""
     output = record["outputs"][0]
     if output.get("format") != event_table.FORMAT:
-        return []
-    table = event_table.read_slip_events(_beside(record_file, output["path"]))
+        return [], []
+    path = _beside(record_file, output["path"])
+    table = event_table.read_slip_events(path)
     simulation = next(entry for entry in record["inputs"] if entry["role"] == "simulation")
     identity = {"analysis_run_id": record["run_id"], "simulation_run_id": simulation["run_id"],
-                "analysis": record["plugin"], "solver": simulation["plugin"],
-                "source": _format(simulation["format"], record_file).source}
+                "analysis": record["plugin"]}
+    events_identity = {**identity, "solver": simulation["plugin"],
+                       "source": _format(simulation["format"], record_file).source}
     standard = [c for c in table.columns if c in event_table.COLUMNS]
     further = [c for c in table.columns if c not in event_table.COLUMNS]
-    return [{**identity, **{c: _python(row[c]) for c in standard},
-             "extra": json.dumps({c: _python(row[c]) for c in further}) if further else None}
-            for row in table.to_dict("records")]
+    events = [{**events_identity, **{c: _python(row[c]) for c in standard},
+               "extra": json.dumps({c: _python(row[c]) for c in further}) if further else None}
+              for row in table.to_dict("records")]
+    periodicity = event_table.read_periodicity(path)
+    summary = [] if periodicity is None else [{**identity, **{c: _python(v) for c, v in row.items()}}
+                                              for row in periodicity.to_dict("records")]
+    return events, summary
 
 
 def _figure_row(record):
@@ -144,7 +151,8 @@ def _figure_row(record):
 def _ingest_record(session, record, record_file):
     """Replace the rows of one run by those of its record; return the number of slip events added."""
     run_id = record["run_id"]
-    for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (ArtifactRow, ArtifactRow.run_id),
+    for model, key in ((SlipEvent, SlipEvent.analysis_run_id), (RunPeriodicity, RunPeriodicity.analysis_run_id),
+                       (ArtifactRow, ArtifactRow.run_id),
                        (Simulation, Simulation.run_id), (Figure, Figure.run_id), (Run, Run.run_id)):
         session.execute(delete(model).where(key == run_id))
     session.execute(insert(Run), [_run_row(record, record_file)])
@@ -155,9 +163,11 @@ def _ingest_record(session, record, record_file):
     if record["kind"] == "solver":
         session.execute(insert(Simulation), [_simulation_row(record, record_file)])
     elif record["kind"] == "analysis":
-        events = _event_rows(record, record_file)
+        events, periodicity = _event_rows(record, record_file)
         if events:
             session.execute(insert(SlipEvent), events)
+        if periodicity:
+            session.execute(insert(RunPeriodicity), periodicity)
     elif record["kind"] == "figure":
         session.execute(insert(Figure), [_figure_row(record)])
     return len(events)
