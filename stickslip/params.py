@@ -19,6 +19,10 @@ A field added to a plugin after runs were made is declared with ``extension=True
 while it has its default it is left out of :func:`params_to_dict`, so the run ids,
 stored parameters and files of the runs made before it keep their bytes (its default
 must reproduce what those runs did); any other value is stored and keyed as usual.
+A field that only matters when another extension field is set (e.g. the attempt rate
+of a thermal run, which matters only at a finite temperature) is declared with
+``extension="<that field>"``: it is left out while both it and that field have their
+defaults, and stored (with the run id keyed on it) as soon as either has another value.
 """
 
 import dataclasses
@@ -61,9 +65,10 @@ def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, ex
         Inclusive bounds (for tuples: of every element).
     exclusive_minimum : float, optional
         Exclusive lower bound (for tuples: of every element).
-    extension : bool, optional
+    extension : bool or str, optional
         The field was added after runs were made: at its default it is left out of
         :func:`params_to_dict` (run ids, stored parameters), so those runs keep their ids.
+        The name of another field: left out only while that field is at its default too.
 
     Returns
     -------
@@ -71,7 +76,7 @@ def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, ex
     """
     meta = {"doc": doc, "unit": unit, "choices": tuple(choices) if choices is not None else None,
             "minimum": minimum, "maximum": maximum, "exclusive_minimum": exclusive_minimum,
-            "extension": bool(extension)}
+            "extension": extension if isinstance(extension, str) else bool(extension)}
     return dataclasses.field(default=default, metadata=meta)
 
 
@@ -246,11 +251,22 @@ def did_you_mean(name, choices):
 def params_to_dict(instance):
     """Return the parameters as a JSON-safe dict (tuples become lists), in field order.
 
-    Fields declared with ``extension=True`` are left out while they have their default.
+    Fields declared with ``extension=True`` are left out while they have their default; those
+    declared with ``extension="<field>"`` while that field has its default too.
     """
+    fields = {f.name: f for f in dataclasses.fields(instance)}
+
+    def at_default(name):
+        return getattr(instance, name) == fields[name].default
+
+    def left_out(f):
+        extension = f.metadata.get("extension")
+        if not extension:
+            return False
+        return at_default(f.name) and (extension is True or at_default(extension))
+
     return {f.name: list(v) if isinstance(v := getattr(instance, f.name), tuple) else v
-            for f in dataclasses.fields(instance)
-            if not (f.metadata.get("extension") and getattr(instance, f.name) == f.default)}
+            for f in fields.values() if not left_out(f)}
 
 
 _JSON_TYPES = {int: "integer", float: "number", bool: "boolean", str: "string"}

@@ -82,3 +82,17 @@ def test_an_extension_field_at_its_default_leaves_the_stored_parameters_and_the_
     assert params_to_dict(changed) == {**params_to_dict(before), "law": "smooth"}
     assert run_id(plugin, changed) != run_id(plugin, before)
     assert parse_params(Extended, params_to_dict(changed)) == changed  # stored and read back
+
+
+def test_an_extension_field_tied_to_another_is_stored_whenever_either_is_set():
+    @dataclasses.dataclass(frozen=True)
+    class Thermal(Example):
+        temperature: float = param(0.0, "temperature", minimum=0.0, extension=True)
+        rate: float = param(1.0, "attempt rate", exclusive_minimum=0.0, extension="temperature")
+
+    base = params_to_dict(parse_params(Example, {"N": 27}))
+    assert params_to_dict(parse_params(Thermal, {"N": 27})) == base
+    hot = parse_params(Thermal, {"N": 27, "temperature": 0.5})
+    assert params_to_dict(hot) == {**base, "temperature": 0.5, "rate": 1.0}  # the default rate is stated
+    assert params_to_dict(parse_params(Thermal, {"N": 27, "rate": 2.0})) == {**base, "rate": 2.0}
+    assert parse_params(Thermal, params_to_dict(hot)) == hot

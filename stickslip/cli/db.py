@@ -19,7 +19,7 @@ FORMATS = ("table", "csv", "json")
 
 #: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
 RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "blocks", "phi", "regime",
-               "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
+               "temperature", "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
 
 EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",
                  "interface", "slip", "dmu", "multi", "time", "increment")

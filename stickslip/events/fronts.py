@@ -46,7 +46,8 @@ from . import extraction
 from .plugin import event_attrs
 
 __all__ = ["FrontParams", "VERSION", "BRANCHES", "MIN_R2", "slipping_interfaces", "p_wave_speed", "front_fit",
-           "analyse_event", "multi_slip_increments", "interface_spacing", "front_tables", "write_front_file", "run"]
+           "analyse_event", "multi_slip_increments", "interface_spacing", "front_tables", "write_front_file",
+           "solver_replay", "run"]
 
 NAME = "front-dynamics"
 VERSION = "2"  # 2: the two branches fitted separately (Theil-Sen), fits flagged by quality
@@ -369,10 +370,10 @@ def write_front_file(failures, fronts, attrs, output, *, input, params=FrontPara
                         attrs=attrs, tables={"failures": failures, "fronts": fronts})
 
 
-def _replay(input):
-    """The replay of the solver that wrote ``input`` (from its lineage)."""
+def solver_replay(input, analysis=NAME):
+    """The replay of the solver that wrote ``input`` (from its lineage), for the analysis ``analysis``."""
     if not isinstance(input, Artifact):
-        raise FileFormatError(f"{input}: front-dynamics needs the lineage of its input (a "
+        raise FileFormatError(f"{input}: {analysis} needs the lineage of its input (a "
                               "stickslip.lineage.Artifact naming the solver that wrote it)")
     solver = registry.get("solver", input.plugin)
     if solver.replay is None:
@@ -383,7 +384,7 @@ def _replay(input):
 @register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")
 def run(params, input, output):
     """Re-run multi-slip events of a fem run recording every block failure; front speed and delay."""
-    replay = _replay(input)
+    replay = solver_replay(input)
     run_attrs = read_run_attrs(input)
     N = int(run_attrs["N"])
     with h5io.open_file(input) as file:

@@ -85,9 +85,35 @@ class FemParams:
     backend: str = param(DEFAULT_BACKEND, "how the numbers are computed: 'structured' (stencil kernels, default) "
                                           "or 'assembled' (the CSR reference; other round-off, so its own run id)",
                          choices=tuple(BACKENDS), extension=True)
+    temperature: float = param(0.0, "thermal activation of the interface blocks: 0 is the paper's athermal event-driven "
+                                    "protocol; > 0 the kinetic Monte Carlo protocol with a finite drive rate "
+                                    "(docs/fem.md, 'Finite temperature'); energy in units of the barrier of a block a "
+                                    "strain eps0 below its yield strain, G eps0^2 h^2", unit="G eps0^2 h^2", minimum=0.0,
+                               extension=True)
+    attempt_rate: float = param(1.0, "temperature > 0: attempt rate nu of a block's hop over a barrier E, at rate "
+                                     "nu exp(-E / temperature)", unit="1/time", exclusive_minimum=0.0,
+                                extension="temperature")
+    drive_rate: float = param(1e-9, "temperature > 0: rate of the imposed shear gamma (fixed lever; free lever: of the "
+                                    "lever's drive target)", unit="eps0/time", exclusive_minimum=0.0,
+                              extension="temperature")
+    hold_times: tuple[float, ...] = param((), "temperature > 0: slide-hold-slide: after every slip event (every block "
+                                              "of an interface changed well) the drive stops for the next of these "
+                                              "times, cycled; empty: no holds", unit="time", minimum=0.0,
+                                          extension="temperature")
+    hold_delay: float = param(0.0, "temperature > 0 with hold_times: the drive's advance after a slip event at "
+                                   "which the hold starts (a slip before it postpones the hold)", unit="eps0",
+                              minimum=0.0, extension="temperature")
 
     def check(self):
         """Check conditions across fields."""
+        if self.temperature > 0.0 and self.yield_strains != "extend":
+            raise ParameterError("parameter 'yield_strains': a thermal run (temperature > 0) needs 'extend'")
+        if self.temperature == 0.0:
+            for name in ("attempt_rate", "drive_rate", "hold_times", "hold_delay"):
+                field = self.__dataclass_fields__[name]
+                if getattr(self, name) != field.default:
+                    raise ParameterError(f"parameter '{name}': used only with temperature > 0; expected a "
+                                         "temperature > 0 or the default")
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")

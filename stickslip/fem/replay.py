@@ -4,6 +4,8 @@ The replay is the ``fem`` solver's capability (:func:`stickslip.registry.registe
 ``replay=``): an analysis asks the solver that wrote a file to replay its events. The
 model is built once per run file; each replay restores the stored state before the kick
 and runs the same kick and minimisation as the run (:meth:`.system.System.kick_and_minimise`).
+For a thermal run it also holds a stored state at a load and reloads it
+(:meth:`EventReplay.hold`, :mod:`.thermal.holds`).
 """
 
 import numpy as np
@@ -51,6 +53,20 @@ class EventReplay:
     def _state(self, increment):
         with open_file(self.path) as file:
             return RunFile(file).state(increment)
+
+    def hold(self, increment, hold_time, below, replica):
+        """A hold trial from a stored increment of a thermal run (:func:`.thermal.holds.hold_trial`).
+
+        Raises
+        ------
+        FileFormatError
+            If the run is athermal (``temperature = 0``) or the increment is not stored.
+        """
+        from .thermal.holds import hold_trial
+
+        if self.params.temperature <= 0.0:
+            raise FileFormatError(f"{self.path}: an athermal run (temperature = 0) has no hold trials")
+        return hold_trial(self.system, self._state(increment), hold_time, below, replica)
 
     def failures(self, increment):
         """Redo one kick increment and record every well hop of the interface blocks.

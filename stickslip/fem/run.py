@@ -26,15 +26,15 @@ import numpy as np
 
 from .. import progress
 from ..formats.fem_run import RunFile, append_increment, create_file, rewrite
-from ..h5io import FileFormatError, UnreadableFileError, open_file
+from ..h5io import FileFormatError, UnreadableFileError, open_file, read_table
 from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
 from ..output_safety.overwrite import set_aside
 from ..output_safety.space import check_free_space
 from ..params import params_to_dict
-from .minimise import within_margin
 from .observables import Observer, observable_columns
 from .parameters import stored_params
+from .protocol import make_protocol
 from .stiffness import driving_regime, stiffness_ratio
 from .system import System
 
@@ -45,8 +45,8 @@ __all__ = ["run_simulation"]
 FREE_SPACE_MARGIN = 4 * 2**20
 
 
-def _row(observer, increment, kick, yield_element, previous_index):
-    row = {"increment": increment, "kick": kick, "yield_element": yield_element}
+def _row(observer, increment, kick, previous_index, columns):
+    row = {"increment": increment, "kick": kick, **columns}
     row.update(observer.observe(previous_index))
     return row
 
@@ -76,27 +76,31 @@ class _Progress:
         self.bar.update(1)
 
 
-def _header(system, observer, producer):
-    """Root attributes of the run file: the fields of :data:`stickslip.formats.fem_run.HEADER`, then ``fem``'s own."""
+def _header(system, observer, protocol, producer):
+    """Root attributes of the run file: the fields of :data:`stickslip.formats.fem_run.HEADER`, then ``fem``'s own
+    (the protocol's last)."""
     p, c = system.params, system.constants
     phi = stiffness_ratio(p.k_drive, p.N, p.G)
     return {"solver": producer[0], "solver_version": producer[1], "params": params_to_dict(p),
             "N": p.N, "plates": p.plates, "n_interfaces": p.plates - 1, "k_drive": p.k_drive, "drive": p.drive,
             "seed": p.seed, "nchunk": p.nchunk, "eps0": p.eps0, "sig0": c["sig0"], "gamma0": observer.gamma0,
             "c_s": c["c_s"], "h": c["h"], "dt": c["dt"], "alpha": c["alpha"], "H": c["H"],
-            "phi": phi, "regime": driving_regime(phi)}
+            "phi": phi, "regime": driving_regime(phi), **protocol.header}
 
 
 def _create(path, params, mesh, backend, producer):
     system = System(params, mesh, backend)
     system.compute_linear_response()
     observer = Observer(system)
+    protocol = make_protocol(system)
     columns = observable_columns(observer.nlayer, observer.n_interfaces, system.model.free_lever)
     response = (system.delta_u, system.delta_eps, system.delta_target, system.delta_lever)
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
-            create_file(file, _header(system, observer, producer), system.mesh, response, columns)
-            append_increment(file, system.snapshot(), _row(observer, 0, True, False, observer.well_index()))
+            create_file(file, _header(system, observer, protocol, producer), system.mesh, response,
+                        columns + list(protocol.columns), protocol.columns)
+            append_increment(file, system.snapshot(), _row(observer, 0, True, observer.well_index(),
+                                                           {"yield_element": False, **protocol.initial_row()}))
 
 
 def _stored(output, params):
@@ -186,6 +190,7 @@ def _increments(params, output, backend):
         increment = run.nstored - 1
         system.restore(*run.state(increment))
         observer = Observer(system)
+        protocol = make_protocol(system, read_table(file, "increments", rows=run.nstored))
         kick = bool(file["increments/kick"][increment])
         previous_index = observer.well_index()
         new = 0
@@ -199,22 +204,17 @@ def _increments(params, output, backend):
                 break
             increment += 1
             kick = not kick
-            yield_element = False
-            if kick:
-                converged, yield_element = system.kick(params.margin)
-                if not converged:
-                    reason = "margin"
-                    break
-            else:
-                system.event_step(False)
-                if not system.extend and not within_margin(system.model, system.state.idx, params.margin):
-                    reason = "margin"
-                    break
+            columns = protocol.step(kick, params.margin, increment)
+            if columns is None:
+                reason = "margin"
+                break
             if last_well is not None and system.well_index().max() >= last_well:
                 reason = "margin"
                 break
             check_free_space(output, needed, FREE_SPACE_MARGIN)
-            append_increment(file, system.snapshot(), _row(observer, increment, kick, yield_element, previous_index))
+            row = _row(observer, increment, kick, previous_index, columns)
+            append_increment(file, system.snapshot(), row)
+            protocol.stored(row)
             previous_index = observer.well_index()
             new += 1
             report.stored(file, increment)

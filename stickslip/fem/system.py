@@ -314,6 +314,41 @@ class System:
         self.delta_target = np.asarray(delta_target, dtype=np.float64)
         self.delta_lever = float(delta_lever)
 
+    def step_size(self, kick, yield_element=False):
+        """The step along the linear response that :meth:`event_step` makes (nothing is changed).
+
+        Parameters
+        ----------
+        kick : bool
+            Kick (smallest step that changes a well index) or elastic load step (largest step that changes none).
+        yield_element : bool
+            Kick until all Gauss points of one element change well.
+
+        Returns
+        -------
+        float
+            The step [in units of the linear response] (0: already at the brink).
+
+        Raises
+        ------
+        SolverError
+            If no yielding step exists.
+        """
+        s, m = self.state, self.model
+        step = step_size(m.epsy, m.iface_dofs, m.iface_dNdx, s.u, self.delta_u, s.eps, self.delta_eps, s.idx,
+                         self.constants["deps"], kick, yield_element and kick)
+        if step < 0.0:
+            raise SolverError("no step along the linear response makes a block yield")
+        return step
+
+    def load(self, step):
+        """Move the state by ``step`` along the linear response (displacement and drive; no dynamics)."""
+        s = self.state
+        s.u[:] += step * self.delta_u
+        s.target[:] += step * self.delta_target
+        s.lever[0] += step * self.delta_lever
+        self.refresh()
+
     def event_step(self, kick, yield_element=False):
         """Elastic load step to the brink of yielding, or kick past it (no dynamics).
 
@@ -336,23 +371,16 @@ class System:
         """
         s = self.state
         idx = s.idx.copy()
-        m = self.model
-        step = step_size(m.epsy, m.iface_dofs, m.iface_dNdx, s.u, self.delta_u, s.eps, self.delta_eps, idx,
-                         self.constants["deps"], kick, yield_element and kick)
-        if step < 0.0:
-            raise SolverError("no step along the linear response makes a block yield")
-        s.u[:] += step * self.delta_u
-        s.target[:] += step * self.delta_target
-        s.lever[0] += step * self.delta_lever
-        self.refresh()
+        step = self.step_size(kick, yield_element)
+        self.load(step)
         changed = np.any(s.idx != idx)
         if kick != changed:
             raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
                               f"{'did not change' if kick else 'changed'}")
         return step
 
-    def kick_and_minimise(self, yield_element, margin, record=False):
-        """Kick (:meth:`event_step`) and :meth:`minimise`; with ``extend``, redone until the held wells suffice.
+    def kick_and_minimise(self, yield_element, margin, record=False, kick=None):
+        """Kick (:meth:`event_step`, or ``kick``) and :meth:`minimise`; with ``extend``, redone until the held wells suffice.
 
         With ``yield_strains = extend``, a minimisation that comes within ``margin``
         wells of the end of the held wells is discarded: the state before the kick is
@@ -368,6 +396,10 @@ class System:
         record : bool, optional
             Record the well changes of Gauss point 0, the kick's own included (at the
             time of the kick).
+        kick : callable, optional
+            ``kick()`` changes the state instead of the kick along the linear response (e.g. the
+            local kick of a thermally activated block, :mod:`.thermal.hop`); it is called again
+            after every restore.
 
         Returns
         -------
@@ -379,7 +411,10 @@ class System:
         before = self.snapshot()
         while True:
             index = self.state.idx[:, 0].copy()
-            self.event_step(True, yield_element=yield_element)
+            if kick is None:
+                self.event_step(True, yield_element=yield_element)
+            else:
+                kick()
             kicked = self.state.idx[:, 0] - index
             niter, events = self.minimise(margin=margin, record=record)
             if niter or not self.extend:

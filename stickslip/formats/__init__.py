@@ -13,9 +13,9 @@ Built-in formats (``docs/developing.md`` draws the data flow):
 format         reader/writer                            producers -> consumers
 =============  =======================================  ========================================
 mesh           :mod:`stickslip.mesh.io`                 mesh stage -> ``fem`` (solver input), figS-mesh
-fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics
+fem-run        :mod:`stickslip.formats.fem_run`         ``fem`` -> numerical-events, front-dynamics, thermal-events
 timeseries     :mod:`stickslip.experiment.timeseries`   ``lever``, lab CSV import -> experiment-events
-event-table    :mod:`stickslip.formats.event_table`     numerical-events, experiment-events -> figures, database
+event-table    :mod:`stickslip.formats.event_table`     numerical-, experiment-, thermal-events -> figures, database
 front-table    :mod:`stickslip.formats.front_table`     front-dynamics -> figS-event-maps, figS-tau
 =============  =======================================  ========================================
 
@@ -67,7 +67,7 @@ class Format:
     describe : str or None
         ``"module:function"``: ``function(path) -> dict`` of the database's simulation
         columns (``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
-        ``phi``, ``regime``, ``seed``) read from one file.
+        ``phi``, ``regime``, ``seed``, ``temperature``, ``attempt_rate``, ``drive_rate``) read from one file.
     unstamped : int or None
         The version a file without ``format`` attributes is read as (its layout is
         documented for other writers, e.g. lab scripts; the reader validates the

@@ -14,7 +14,9 @@ equal runs give equal bytes):
     ``params``, ``N``, ``plates``, ``n_interfaces``, ``k_drive``, ``seed``, the
     normalisation ``eps0``, ``sig0``, ``gamma0`` [deg], ``c_s``, ``h``, ``dt``, the
     rigidity ratio ``phi`` and the driving ``regime``) and any further attributes of
-    the producer (``fem``: ``drive``, ``nchunk``, ``alpha``, ``H``); then ``version``
+    the producer (``fem``: ``drive``, ``nchunk``, ``alpha``, ``H``; a thermal ``fem`` run also
+    ``protocol`` = "thermal", ``temperature``, ``attempt_rate``, ``drive_rate``, ``hold_times``,
+    ``hold_delay``, ``energy_unit``: docs/fem.md, "Finite temperature"); then ``version``
     (package), ``nstored`` (complete increments) and ``completed`` (bool) with
     ``stop_reason`` ("margin" or "max_increments").
 ``/mesh``
@@ -30,8 +32,9 @@ equal runs give equal bytes):
     The observables table (one 1-D dataset per column, attribute ``columns``,
     readable by :func:`stickslip.h5io.read_table`): ``increment``, ``kick``,
     ``yield_element`` and the producer's observables (``fem``:
-    :func:`stickslip.fem.observables.observable_columns`); columns ``S_*`` and ``A_*``
-    are integers, the others floats.
+    :func:`stickslip.fem.observables.observable_columns`; a thermal run adds ``hop_block``,
+    ``hop_direction``, ``failed_hops`` (integers) and ``held``); columns ``S_*`` and ``A_*``
+    are integers, the others floats unless the producer types them (``create_file``'s ``dtypes``).
 
 ``phi`` and ``regime`` are the producer's (``fem``: :mod:`stickslip.fem.stiffness`);
 consumers read them from here and never recompute them.
@@ -95,7 +98,7 @@ def _check_header(header):
         raise ValueError(f"fem-run header: regime must be one of {', '.join(REGIMES)}, got {header['regime']!r}")
 
 
-def create_file(file, header, mesh, linear_response, columns):
+def create_file(file, header, mesh, linear_response, columns, dtypes=None):
     """Write the header of a new ``fem-run`` file (no increment yet).
 
     Parameters
@@ -110,6 +113,8 @@ def create_file(file, header, mesh, linear_response, columns):
         ``(delta_u [ndof], delta_eps [ni, 4, 3], delta_target [nlayer], delta_lever)``.
     columns : Sequence[str]
         Columns of the observables table after ``increment``, ``kick``, ``yield_element``.
+    dtypes : Mapping[str, numpy.dtype], optional
+        Types of columns that are neither float64 nor the well counts ``S_*``, ``A_*`` (int64).
 
     Raises
     ------
@@ -134,7 +139,7 @@ def create_file(file, header, mesh, linear_response, columns):
         write_dataset(state, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
     table = file.create_group("increments")
     columns = ["increment", "kick", "yield_element"] + list(columns)
-    dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool}
+    dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool, **(dtypes or {})}
     for name in columns:
         dtype = dtypes.get(name, np.int64 if name[:2] in ("S_", "A_") else np.float64)
         write_dataset(table, name, np.zeros(0, dtype=dtype), maxshape=(None,), chunks=(1024,))
@@ -340,9 +345,13 @@ def describe(path):
     -------
     dict[str, object]
         ``n`` (interfaces), ``plates``, ``blocks`` (N), ``k_drive``, ``phi``, ``regime``, ``seed``:
-        the file's own header.
+        the file's own header; ``temperature`` (a thermal producer's attribute; 0 for a file without it,
+        the athermal protocol), and for a thermal run ``attempt_rate`` and ``drive_rate`` (None otherwise).
     """
     attrs = read_run_attrs(path)
+    thermal = attrs.get("protocol") == "thermal"
     return {"n": int(attrs["n_interfaces"]), "plates": int(attrs["plates"]), "blocks": int(attrs["N"]),
             "k_drive": float(attrs["k_drive"]), "phi": float(attrs["phi"]), "regime": str(attrs["regime"]),
-            "seed": int(attrs["seed"])}
+            "seed": int(attrs["seed"]), "temperature": float(attrs["temperature"]) if thermal else 0.0,
+            "attempt_rate": float(attrs["attempt_rate"]) if thermal else None,
+            "drive_rate": float(attrs["drive_rate"]) if thermal else None}

@@ -31,8 +31,9 @@ __all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "ArtifactRow", "Simula
 #: Version of the table layout; a database of another version must be rebuilt (``stickslip db
 #: rebuild``). 2: ``simulations.phi``; 3: lineage (``artifacts.format``, ``artifacts.made_by``,
 #: ``simulations.format``), ``slip_events`` is the ``event-table`` file's table as it is;
-#: 4: ``run_periodicity`` and the view ``periodicity_full``.
-SCHEMA_VERSION = 4
+#: 4: ``run_periodicity`` and the view ``periodicity_full``; 5: ``simulations.temperature``,
+#: ``attempt_rate``, ``drive_rate`` (thermal fem runs).
+SCHEMA_VERSION = 5
 
 
 class Base(DeclarativeBase):
@@ -111,6 +112,10 @@ class Simulation(Base):
                                                                    "(fem; stickslip.fem.stiffness)")
     regime: Mapped[str | None] = mapped_column(String, index=True, doc="driving regime, e.g. stiff or compliant")
     seed: Mapped[int | None] = mapped_column(Integer)
+    temperature: Mapped[float | None] = mapped_column(Float, doc="thermal activation (fem: 0 for the athermal "
+                                                                "protocol) [G eps0^2 h^2]")
+    attempt_rate: Mapped[float | None] = mapped_column(Float, doc="attempt rate of a thermal fem run [1/time]")
+    drive_rate: Mapped[float | None] = mapped_column(Float, doc="drive rate of a thermal fem run [eps0/time]")
 
 
 class SlipEvent(Base):
@@ -175,8 +180,8 @@ Index("ix_slip_events_sim_interface", SlipEvent.simulation_run_id, SlipEvent.int
 #: Views created with the tables: name -> SELECT.
 VIEWS = {
     "slip_events_full": (
-        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed "
-        "FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
+        "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed, s.temperature, "
+        "s.attempt_rate, s.drive_rate FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
     "periodicity_full": (
         "SELECT p.*, s.solver, s.n, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed, "
         "json_extract(r.params, '$.dt_scale') AS dt_scale FROM run_periodicity AS p "

@@ -8,13 +8,13 @@ one module with its class decorated by :func:`.generic.register_law`, imported h
 """
 
 from .cusp import Cusp
-from .generic import (LAWS, deviatoric_factor, energy_density, forward_barrier, register_law, well_energy,
-                      well_stress)
+from .generic import (LAWS, backward_barrier, deviatoric_factor, energy_density, forward_barrier, register_law,
+                      well_energy, well_stress)
 from .smooth import Smooth
 from .wells import well_index
 
 __all__ = ["LAWS", "INTERFACE_LAWS", "Cusp", "Smooth", "make_law", "register_law", "deviatoric_factor",
-           "well_energy", "forward_barrier", "well_stress", "energy_density", "well_index"]
+           "well_energy", "forward_barrier", "backward_barrier", "well_stress", "energy_density", "well_index"]
 
 #: The laws a run's interfaces may have (the ``interface_law`` parameter of ``fem``).
 INTERFACE_LAWS = tuple(LAWS)

@@ -14,6 +14,9 @@ whose class provides three scalar functions of a Gauss point in the well
     edge ``hi`` against its current load: ``max_{y in [eq, hi]} W(y) - W(eq) - W'(eq) (y - eq)``
     (the load ``W'(eq)`` held constant: the surroundings do not relax during the hop).
 
+Derived from these: :func:`backward_barrier`, the barrier over the back edge ``lo``, by the
+mirror symmetry of a well about its centre (both built-in laws have it).
+
 :func:`register_law` makes these callable, under the generic names below, both from Python
 (the law's own compiled function) and from any compiled kernel, where numba resolves the
 call by the law's type when it compiles the kernel for that law and inlines it. So a kernel
@@ -29,8 +32,8 @@ from numba.extending import overload
 from ...numba_options import njit
 from ..materials import equivalent_strain
 
-__all__ = ["LAWS", "register_law", "deviatoric_factor", "well_energy", "forward_barrier", "well_stress",
-           "energy_density"]
+__all__ = ["LAWS", "register_law", "deviatoric_factor", "well_energy", "forward_barrier", "backward_barrier",
+           "well_stress", "energy_density"]
 
 #: Registered laws by name (:func:`register_law`).
 LAWS = {}
@@ -90,6 +93,17 @@ def register_law(cls):
         _dispatch(globals()[name], cls)
     LAWS[cls.name] = cls
     return cls
+
+
+@njit
+def backward_barrier(law, eq, lo, hi):
+    """Energy density [stress] to cross the well's back edge ``lo`` from ``eq`` at constant load.
+
+    The forward barrier of the mirror point ``lo + hi - eq``: exact for a law whose well is symmetric
+    about its centre, ``W(lo + hi - y) = W(y)`` (the cusp and smooth laws), which a new law must be
+    for thermal runs (:mod:`stickslip.fem.thermal`) or provide its own. Cusp: ``G (eq - lo)^2``.
+    """
+    return forward_barrier(law, lo + hi - eq, lo, hi)
 
 
 @njit

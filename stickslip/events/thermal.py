@@ -1,0 +1,223 @@
+"""The ``thermal-events`` analysis plugin: slips with their waiting times, slow slip and hold trials of a fem run.
+
+What the experimental analysis measures (docs/experimental-analysis.md, sections 4 and 5), measured
+on a ``fem`` run with a clock (a thermal run, ``temperature > 0``), plus the slide-hold-slide
+experiment done on its stored states:
+
+- **slips**: every steady-state slip of an interface (:func:`.extraction.slip_interfaces`) with
+  ``time`` (the run's clock ``t``), ``T`` (time since the previous slip of the same interface, any
+  slip of it counted, also before the steady state), ``hold`` (time of ``T`` during which the drive
+  was held), ``mu_before`` (the interface's stress before the slip, its peak [sig0]) and the aging
+  rate of the slip ``B_a = dmu / ln(T / T0)`` with the microscopic time ``T0 = 1 / attempt_rate``;
+  for an athermal run, whose ``t`` counts minimisation time steps, not time, these are NaN;
+- **slow slip** per interface over the steady state: the interface's plastic slip ``R_a`` counted in
+  well hops (the signed hops ``S_a`` of its blocks, Gauss point 0, summed over the increments; the
+  model's counterpart of the slabs' relative position: the relative displacement of the plates would
+  include their elastic shear, which returns every cycle and is no slip), ``R_tot`` its growth,
+  ``dR_sum`` the part made in the interface's slip events (the paper's numerical slip criterion,
+  ``A_a == N``), ``R_slow = 1 - dR_sum / R_tot`` (:func:`stickslip.experiment.aging.slow_slip_fraction`):
+  the slip made by microscopic events, thermally activated or not;
+- **hold trials** (thermal runs with ``hold_interfaces`` interfaces, any if 0): ``states`` steady-state
+  slip increments, evenly spaced, each held
+  for every one of ``hold_times`` at a load ``below`` under its athermal threshold and reloaded
+  (:mod:`stickslip.fem.thermal.holds`, through the solver's replay), paired: every hold time of a
+  state draws from the same random stream.
+
+Output (format ``event-table``): ``slip_events`` (the normalised table; further columns ``T``,
+``hold``, ``B_a``, ``mu_before``, ``dgamma``), ``interfaces`` (``a``, ``R_tot``, ``dR_sum`` [well hops],
+``R_slow``, ``n_slips``), ``holds`` (one row per trial: ``trial``, ``state`` (increment), ``replica``,
+``hold_time``, ``peak``, ``interface``, ``mu_start`` [sig0], ``failed_in_hold``, ``t_slip``,
+``hold_hops``, ``events``), ``creep`` (``trial``, ``t`` since the hold's start, ``R_<a>`` the slip of
+interface a since then [well hops], after each hop within a hold), ``barriers`` (``trial``, ``block``,
+``start``, ``end``: every block's forward barrier at the start and end of the hold, in units of the
+temperature). Times are the run's (FE time units); root attributes as ``numerical-events`` plus
+``T0`` and ``thermal``.
+"""
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+
+from .. import progress
+from ..experiment.aging import aging_rate, slow_slip_fraction
+from ..formats.analysis_file import write_analysis_file
+from ..formats.event_table import slip_events_table
+from ..h5io import FileFormatError
+from ..params import param
+from ..registry import register
+from . import extraction
+from .fronts import solver_replay
+from .plugin import event_attrs
+
+__all__ = ["ThermalEventParams", "NAME", "VERSION", "slip_table", "interface_table", "hold_tables", "run"]
+
+NAME = "thermal-events"
+VERSION = "1"
+
+
+@dataclasses.dataclass(frozen=True)
+class ThermalEventParams:
+    """Parameters of the hold trials (the slip and slow-slip tables have none)."""
+
+    states: int = param(10, "hold trials: number of steady-state slip increments held (0: no trials)", minimum=0)
+    hold_times: tuple[float, ...] = param((0.0, 1e6, 1e8, 1e10, 1e12), "hold trials: hold durations",
+                                          unit="1/attempt_rate", minimum=0.0)
+    below: float = param(0.02, "hold trials: imposed shear between the held load and the athermal threshold",
+                         unit="eps0", minimum=0.0)
+    hold_interfaces: int = param(1, "hold trials only in runs with this many interfaces (0: every run)", minimum=0)
+
+
+def _slip_rows(classified, N, a):
+    """Rows of every kick increment in which interface ``a`` slipped (steady state or not)."""
+    return np.flatnonzero(classified["kick"].to_numpy(dtype=bool) & (classified[f"A_a{a}"].to_numpy() == N))
+
+
+def slip_table(increments, classified, N, *, T0=None):
+    """The normalised slip table of a run, with waiting times (module docstring).
+
+    Parameters
+    ----------
+    increments : pandas.DataFrame
+        The run's increment table (:func:`stickslip.formats.fem_run.read_increments`): ``t`` and, for a
+        thermal run, ``held``.
+    classified : pandas.DataFrame
+        Its :func:`.extraction.classify_increments`.
+    N : int
+    T0 : float, optional
+        ``1 / attempt_rate`` of a thermal run; None: the run has no clock (times are NaN).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`stickslip.formats.event_table.slip_events_table` with ``time``, ``T``, ``hold``, ``B_a``,
+        ``mu_before``, ``dgamma``.
+    """
+    per_interface = extraction.slip_interfaces(classified, N)
+    increment = classified["increment"].to_numpy()
+    t = increments["t"].to_numpy(dtype=float)
+    held = np.cumsum(increments["held"].to_numpy(dtype=float)) if "held" in increments else np.zeros(t.size)
+    position = {inc: i for i, inc in enumerate(increment)}
+    rows = np.array([position[inc] for inc in per_interface["increment"]], dtype=np.int64)
+    waits, holds, before = np.full(rows.size, np.nan), np.full(rows.size, np.nan), np.empty(rows.size)
+    for a in np.unique(per_interface["a"]):
+        mine = np.flatnonzero(per_interface["a"].to_numpy() == a)
+        slips = _slip_rows(classified, N, a)
+        previous = slips[np.searchsorted(slips, rows[mine]) - 1]
+        first = np.searchsorted(slips, rows[mine]) == 0
+        if T0 is not None:
+            waits[mine] = np.where(first, np.nan, t[rows[mine]] - t[previous])
+            holds[mine] = np.where(first, np.nan, held[rows[mine]] - held[previous])
+        before[mine] = classified[f"mu_a{a}"].to_numpy(dtype=float)[rows[mine] - 1]
+    time = t[rows] if T0 is not None else np.full(rows.size, np.nan)
+    return slip_events_table(pd.DataFrame({
+        "event": np.unique(per_interface["increment"].to_numpy(), return_inverse=True)[1].reshape(-1),
+        "interface": per_interface["a"], "multi": ~per_interface["single"].to_numpy(dtype=bool),
+        "dmu": per_interface["dmu"], "time": time, "increment": per_interface["increment"],
+        "T": waits, "hold": holds, "B_a": aging_rate(per_interface["dmu"], waits, t0=T0 or 1.0),
+        "mu_before": before, "dgamma": per_interface["dgamma"]}))
+
+
+def interface_table(classified, N):
+    """Slow slip of every interface over the steady state (module docstring), from :func:`.extraction.classify_increments`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``a``, ``R_tot``, ``dR_sum`` [well hops], ``R_slow``, ``n_slips``; no rows without a steady state.
+    """
+    steady = np.flatnonzero(classified["steady"].to_numpy(dtype=bool))
+    rows = []
+    for a in extraction.interfaces_in(classified):
+        if steady.size == 0:
+            continue
+        hops = classified[f"S_a{a}"].to_numpy(dtype=float)
+        slips = _slip_rows(classified, N, a)
+        slips = slips[slips > steady[0]]
+        R_tot = float(np.sum(hops[steady[0] + 1:]))
+        dR_sum = float(np.sum(hops[slips]))
+        rows.append({"a": a, "R_tot": R_tot, "dR_sum": dR_sum, "R_slow": float(slow_slip_fraction(R_tot, dR_sum)),
+                     "n_slips": slips.size})
+    return pd.DataFrame(rows, columns=["a", "R_tot", "dR_sum", "R_slow", "n_slips"])
+
+
+def hold_tables(hold, states, params, T0, n_interfaces):
+    """The hold trials of a thermal run (module docstring).
+
+    Parameters
+    ----------
+    hold : callable
+        ``hold(increment, hold_time, below, replica)``: :meth:`stickslip.fem.replay.EventReplay.hold`.
+    states : Sequence[int]
+        Stored increments to hold (one replica each).
+    params : ThermalEventParams
+    T0 : float
+        ``1 / attempt_rate`` (the unit of ``params.hold_times``).
+    n_interfaces : int
+
+    Returns
+    -------
+    tuple[pandas.DataFrame, pandas.DataFrame, pandas.DataFrame]
+        ``holds``, ``creep``, ``barriers``.
+    """
+    holds, creep, barriers = [], [], []
+    names = [f"R_{a}" for a in range(1, n_interfaces + 1)]
+    bar = progress.bar(len(states) * len(params.hold_times), desc="hold trials", unit="trial")
+    for replica, state in enumerate(states):
+        for hold_time in params.hold_times:
+            trial = len(holds)
+            result = hold(int(state), hold_time * T0, params.below, replica)
+            holds.append({"trial": trial, "state": int(state), "replica": replica, "hold_time": hold_time * T0,
+                          **{k: result[k] for k in ("peak", "interface", "mu_start", "failed_in_hold", "t_slip",
+                                                    "hold_hops", "events")}})
+            rows = result["creep"]
+            creep.append(pd.DataFrame({"trial": np.full(len(rows), trial), "t": rows[:, 0],
+                                       **{name: rows[:, k + 1] for k, name in enumerate(names)}}))
+            blocks = result["barriers_start"].size
+            barriers.append(pd.DataFrame({"trial": np.full(blocks, trial), "block": np.arange(blocks),
+                                          "start": result["barriers_start"], "end": result["barriers_end"]}))
+            bar.update(1)
+    bar.close()
+    columns = ["trial", "state", "replica", "hold_time", "peak", "interface", "mu_start", "failed_in_hold", "t_slip",
+               "hold_hops", "events"]
+    holds = pd.DataFrame(holds, columns=columns).astype({"trial": np.int64, "state": np.int64,
+                                                         "replica": np.int64, "interface": np.int64,
+                                                         "failed_in_hold": bool, "hold_hops": np.int64,
+                                                         "events": np.int64})
+    empty_creep = pd.DataFrame({"trial": np.zeros(0, np.int64), "t": np.zeros(0),
+                                **{name: np.zeros(0) for name in names}})
+    empty_barriers = pd.DataFrame({"trial": np.zeros(0, np.int64), "block": np.zeros(0, np.int64),
+                                   "start": np.zeros(0), "end": np.zeros(0)})
+    return (holds, pd.concat([empty_creep, *creep], ignore_index=True),
+            pd.concat([empty_barriers, *barriers], ignore_index=True))
+
+
+@register("analysis", NAME, VERSION, ThermalEventParams, consumes=("fem-run",), produces="event-table")
+def run(params, input, output):
+    """Slips with waiting times and aging rates, slow slip, and hold trials (thermal runs) of a fem run."""
+    from ..formats.fem_run import read_increments, read_run_attrs
+
+    run_attrs = read_run_attrs(input)
+    if "N" not in run_attrs:
+        raise FileFormatError(f"{input}: run attributes lack N")
+    N, n = int(run_attrs["N"]), int(run_attrs["n_interfaces"])
+    increments = read_increments(input)
+    classified = extraction.classify_increments(increments, N, source=str(input))
+    temperature = float(run_attrs.get("temperature", 0.0))
+    thermal = temperature > 0.0
+    T0 = 1.0 / float(run_attrs["attempt_rate"]) if thermal else None
+    slips = slip_table(increments, classified, N, T0=T0)
+    steady_slips = np.unique(slips["increment"].to_numpy())
+    states = []
+    if thermal and params.states and steady_slips.size and params.hold_interfaces in (0, n):
+        pick = np.unique(np.linspace(0, steady_slips.size - 1, min(params.states, steady_slips.size)).round())
+        states = steady_slips[pick.astype(np.int64)]
+        replay = solver_replay(input, NAME)
+        holds, creep, barriers = hold_tables(replay.hold, states, params, T0, n)
+    else:
+        holds, creep, barriers = hold_tables(None, [], params, 1.0, n)
+    attrs = {**event_attrs(run_attrs, classified, source=str(input)), "thermal": thermal,
+             "T0": T0 if thermal else np.nan}
+    write_analysis_file(output, "event-table", analysis=NAME, version=VERSION, params=params, input=input,
+                        attrs=attrs, tables={"slip_events": slips, "interfaces": interface_table(classified, N),
+                                             "holds": holds, "creep": creep, "barriers": barriers})

@@ -1,0 +1,109 @@
+"""Hold trials: a stored state of a thermal run held at a load below its athermal threshold, then reloaded.
+
+The slide-hold-slide experiment done on the states of a run, paired: every trial starts from the
+same stored state, so that the hold time is the only difference between trials of that state.
+From a stored state the load is brought (an elastic step along the linear response) to ``below``
+[eps0 of imposed shear] under the state's athermal threshold; the drive is held there for
+``hold_time`` while the blocks hop (creep); then it is driven on at the run's drive rate until the
+next slip event (every block of some interface in another well), which may also come during the
+hold (delayed failure). The trial records the peak stress of the slipping interface (its stress at
+the load increment before the slip), the creep during the hold (the interface's slip in well hops),
+and every block's forward barrier
+at the start and at the end of the hold (the state at rest after the last hop within it).
+"""
+
+import numpy as np
+
+from ..observables import Observer
+from .barriers import FORWARD, block_barriers
+from .protocol import STREAM, ThermalProtocol, drive_scale
+
+__all__ = ["hold_trial", "MAX_EVENTS", "REPLICAS"]
+
+#: Events after which a trial gives up waiting for a slip.
+MAX_EVENTS = 2000
+
+#: Spacing of the random streams of trials (each trial's increments draw from its own range).
+REPLICAS = 2**40
+
+
+def _barriers(system, unit):
+    model, state = system.model, system.state
+    out = np.empty((model.epsy.shape[0], 2))
+    block_barriers(model.law, model.epsy, state.idx, state.eps, system.delta_eps, model.iface_dV, 0.0, out)
+    return out[:, FORWARD] / unit
+
+
+def _slips(observer):
+    """Plastic slip of every interface in well hops: the sum of its blocks' well indices (Gauss point 0)."""
+    return observer.well_index().sum(axis=1).astype(np.float64)
+
+
+def hold_trial(system, state, hold_time, below, replica):
+    """One hold trial from a stored state (module docstring).
+
+    Parameters
+    ----------
+    system : stickslip.fem.system.System
+        Of a thermal run, with its linear response set.
+    state : tuple
+        ``(u, target, lever_target, t)`` of a stored increment (:meth:`stickslip.formats.fem_run.RunFile.state`).
+    hold_time : float
+        Duration of the hold [time].
+    below : float
+        Imposed shear between the hold's load and the athermal threshold [eps0] (>= 0).
+    replica : int
+        Index of the trial's random stream (trials with the same index draw the same numbers).
+
+    Returns
+    -------
+    dict
+        ``t0`` (time at the hold's start), ``peak`` [sig0] and ``interface`` (lowest slipping one; NaN and
+        0 if no slip came within :data:`MAX_EVENTS` events), ``mu_start`` [sig0] (its stress at the hold's
+        start), ``failed_in_hold`` (bool), ``t_slip`` (time from the hold's start to the slip),
+        ``hold_hops``, ``events``; ``creep`` (float64 [k, 1 + n]: time since the hold's start and the
+        slip of every interface since then in well hops of its blocks (Gauss point 0), after each of the
+        ``k`` hops within the hold);
+        ``barriers_start``, ``barriers_end`` (float64 [ni]: forward barrier of every block /
+        temperature, at the start and the end of the hold).
+    """
+    p = system.params
+    system.restore(*state)
+    ds_c = system.step_size(False)
+    system.load(max(ds_c - below / drive_scale(system), 0.0))
+    observer = Observer(system)
+    protocol = ThermalProtocol(system, stream=STREAM + REPLICAS * (replica + 1))
+    unit = protocol.energy_unit * p.temperature
+    t0 = float(system.state.t[0])
+    protocol.schedule.hold_now(t0, hold_time)
+    interfaces = range(1, p.plates)
+    names = [f"sigd_{2 * a - 1}" for a in interfaces]
+    start = observer.observe(observer.well_index())
+    r0 = _slips(observer)
+    barriers_start = barriers_end = _barriers(system, unit)
+    previous = observer.well_index()
+    creep = []
+    result = {"t0": t0, "peak": np.nan, "interface": 0, "mu_start": np.nan, "failed_in_hold": False,
+              "t_slip": np.nan, "hold_hops": 0}
+    for k in range(1, MAX_EVENTS + 1):
+        protocol.step(False, p.margin, 2 * k - 1)
+        load = observer.observe(previous)
+        t = float(system.state.t[0]) - t0
+        previous = observer.well_index()
+        protocol.step(True, p.margin, 2 * k)
+        event = observer.observe(previous)
+        previous = observer.well_index()
+        if t < hold_time:
+            result["hold_hops"] += 1
+            creep.append([t, *(_slips(observer) - r0)])
+            barriers_end = _barriers(system, unit)
+        slipping = [a for a in interfaces if event[f"A_a{a}"] == p.N]
+        if slipping:
+            a = slipping[0]
+            result.update(peak=load[names[a - 1]], interface=a, mu_start=start[names[a - 1]],
+                          failed_in_hold=bool(t < hold_time), t_slip=t)
+            break
+    result["events"] = k
+    result["creep"] = np.asarray(creep, dtype=np.float64).reshape(-1, p.plates)
+    result["barriers_start"], result["barriers_end"] = barriers_start, barriers_end
+    return result

@@ -1,0 +1,157 @@
+"""A thermally activated hop: one block carried over its barrier, then the usual minimisation.
+
+The barrier of a block (:mod:`.barriers`) is the energy to shear it over the edge of its well with
+its surroundings held fixed. The hop does that: the block's shear mode (its upper nodes moved by
+``+s/2`` in x, its lower nodes by ``-s/2``; a uniform simple shear ``eps_xy = s / (2 h)`` of the
+block) is applied with the smallest ``|s|`` that carries every one of its four Gauss points a
+strain ``deps / 2`` past the edge (the athermal kick's overshoot), and the state is minimised
+(:meth:`..system.System.kick_and_minimise`: the relaxation of the run, an avalanche may follow).
+If the minimisation brings every well index back (the block fell back into its well: the true
+barrier of the move is higher than the constant-load one), the state before the hop is restored
+and the hop counts as failed.
+"""
+
+import math
+
+import numpy as np
+
+from ...numba_options import njit
+from ..quad4 import element_strain
+from .barriers import FORWARD
+
+__all__ = ["shear_modes", "hop_step", "hop"]
+
+
+def shear_modes(mesh):
+    """The shear mode of every interface block: ``+1/2`` on the x DOFs of its upper nodes, ``-1/2`` on its lower ones.
+
+    Parameters
+    ----------
+    mesh : stickslip.mesh.LayeredMesh
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 [ni, 8], element DOF order (node-major, x then y), rows in ``interface_elements`` order.
+    """
+    elements = np.asarray(mesh.interface_elements, dtype=np.int64).ravel()
+    y = np.asarray(mesh.coor, dtype=np.float64)[np.asarray(mesh.conn, dtype=np.int64)[elements], 1]  # [ni, 4]
+    modes = np.zeros((elements.size, 8))
+    modes[:, 0::2] = np.where(y > y.mean(axis=1, keepdims=True), 0.5, -0.5)
+    return modes
+
+
+@njit
+def hop_step(dNdx, mode, eps, epsy, idx, direction, overshoot):
+    """Amplitude ``s`` of the shear mode that carries all four Gauss points of one block over an edge.
+
+    Parameters
+    ----------
+    dNdx : numpy.ndarray
+        [4, 4, 2] the block's shape-function gradients.
+    mode : numpy.ndarray
+        [8] its shear mode (:func:`shear_modes`).
+    eps : numpy.ndarray
+        [4, 3] its strain now.
+    epsy : numpy.ndarray
+        [ny] its yield strains.
+    idx : numpy.ndarray
+        int64 [4] the wells of its Gauss points.
+    direction : int
+        :data:`.barriers.FORWARD` (over ``hi``) or backward (over ``lo``).
+    overshoot : float
+        Strain beyond the edge that every Gauss point reaches (the kick's ``deps / 2``).
+
+    Returns
+    -------
+    float
+        ``s`` [length]; NaN if the mode cannot carry every Gauss point over (the block's shear
+        does not move all of them towards the edge).
+    """
+    d = np.empty((4, 3))
+    element_strain(dNdx, mode, d)
+    slope = 0.0
+    for q in range(4):
+        slope += 0.5 * (eps[q, 0] - eps[q, 1]) * 0.5 * (d[q, 0] - d[q, 1]) + eps[q, 2] * d[q, 2]
+    sigma = 1.0 if slope >= 0.0 else -1.0  # the sign of s that raises the block's eps_eq
+    step = 0.0
+    for q in range(4):
+        if direction == FORWARD:
+            target = epsy[idx[q] + 1] + overshoot
+        else:
+            target = epsy[idx[q]] - overshoot
+        et = 0.5 * (eps[q, 0] - eps[q, 1])
+        gt = eps[q, 2]
+        ed = 0.5 * (d[q, 0] - d[q, 1])
+        gd = d[q, 2]
+        a = ed * ed + gd * gd
+        b = 2.0 * (et * ed + gt * gd)
+        c = et * et + gt * gt - target * target
+        disc = b * b - 4.0 * a * c
+        if a == 0.0 or disc < 0.0:
+            return math.nan
+        # forward: the root on the side that raises eps_eq; backward: the nearer root on the other side
+        s = (-b + sigma * math.sqrt(disc)) / (2.0 * a)
+        if (direction == FORWARD) != (s * sigma > 0.0):
+            return math.nan
+        if abs(s) > abs(step):
+            step = s
+    return step
+
+
+def hop(system, modes, block, direction, margin):
+    """Carry ``block`` over its edge in ``direction`` and minimise; restore the state if it falls back.
+
+    Parameters
+    ----------
+    system : stickslip.fem.system.System
+        At rest; its wells must be held with ``yield_strains = extend``.
+    modes : numpy.ndarray
+        [ni, 8] :func:`shear_modes`.
+    block : int
+        Interface element.
+    direction : int
+        :data:`.barriers.FORWARD` or backward.
+    margin : int
+        See :meth:`..system.System.minimise`.
+
+    Returns
+    -------
+    bool
+        True if some well index changed (the hop happened); False if the block fell back or the mode
+        cannot carry it over (the state is then as before).
+
+    Raises
+    ------
+    SolverError
+        If the kick did not move every Gauss point of the block to the next well (a bug, not physics).
+    """
+    from ..system import SolverError
+
+    model, state = system.model, system.state
+    dofs = model.iface_dofs[block]
+    overshoot = 0.5 * system.constants["deps"]
+    if math.isnan(hop_step(model.iface_dNdx[block], modes[block], state.eps[block], model.epsy[block],
+                           state.idx[block], direction, overshoot)):
+        return False
+    before = system.snapshot()
+    index = system.well_index()
+    sign = 1 if direction == FORWARD else -1
+
+    def kick():
+        step = hop_step(system.model.iface_dNdx[block], modes[block], state.eps[block], system.model.epsy[block],
+                        state.idx[block], direction, overshoot)
+        start = system.well_index()[block]
+        state.u[dofs] += step * modes[block]
+        system.refresh()
+        if np.any(np.sign(system.well_index()[block] - start) != sign):
+            raise SolverError(f"hop of block {block}: the kick of {step:.6e} did not carry all its Gauss points "
+                              "over the edge")
+
+    niter, _ = system.kick_and_minimise(False, margin, kick=kick)
+    if niter and system.extend:
+        system.hold_wells_ahead()
+    if np.array_equal(system.well_index(), index):
+        system.restore(*before)
+        return False
+    return True

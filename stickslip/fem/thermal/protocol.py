@@ -1,0 +1,243 @@
+"""The thermal protocol: kinetic Monte Carlo on top of the event-driven protocol, with a drive rate.
+
+Increments alternate as in the athermal protocol, a load then an event:
+
+- **load** (odd increments): from the state at rest after the last event, time runs on: the
+  drive advances at ``drive_rate`` (or is held, see below) along the linear response, which moves
+  every Gauss point within its well, and the next event is drawn exactly
+  (:func:`.sampler.sample_event`): a thermally activated hop of a block, or the athermal threshold
+  if no hop comes first. The stored load increment is the state loaded to the time of that event
+  (for the threshold: the athermal load step to the brink, :meth:`..system.System.event_step`).
+- **event** (even increments): the hop (:func:`.hop.hop`) or the athermal kick
+  (:meth:`..system.System.kick`), with the minimisation of the run.
+
+A hop whose block falls back into its well restores the state, counts as failed (column
+``failed_hops`` of the next load increment) and leaves that block and direction out of the
+rates until the next event; the draw goes on from the time of the failed hop. Avalanches take no
+time: the state's ``t`` is the thermal clock (the minimisation's time steps are not added), which
+assumes that the drive moves the state by much less than a well during an avalanche.
+
+Slide-hold-slide (:class:`HoldSchedule`): once the drive has advanced by ``hold_delay`` since the
+last slip event (an event in which every block of some interface changed well), it stops for the
+next of ``hold_times`` (cycled) while time and hops go on; a slip during the hold ends it, a slip
+before it starts postpones it to the next cycle.
+
+Columns added to the increment table (:data:`COLUMNS`): ``hop_block`` (interface element of the
+hop, -1 for an athermal kick), ``hop_direction`` (+1 forward, -1 backward, 0 athermal), both on the
+load and on the event increment; ``failed_hops`` and ``held`` (time during which the drive was held
+since the previous increment) on load increments (0 on events). Root attributes: ``protocol``
+("thermal"), ``temperature``, ``attempt_rate``, ``drive_rate``, ``hold_times``, ``hold_delay``, and
+``energy_unit`` (``G eps0^2 h^2`` in model units, the unit of ``temperature``).
+
+Every quantity needed to go on is in the stored increments, and the random numbers of increment
+``i`` come from the pcg32 stream ``(seed, 2^32 + i)``: a run resumed from any stored increment
+gives the same bytes.
+"""
+
+import math
+
+import numpy as np
+
+from ..random import pcg32_seed
+from .barriers import BACKWARD, FORWARD
+from .hop import hop, shear_modes
+from .sampler import HOP, NONE, sample_event
+
+__all__ = ["ThermalProtocol", "HoldSchedule", "COLUMNS", "drive_scale", "energy_unit", "STREAM"]
+
+#: The increment table's thermal columns and their types.
+COLUMNS = {"hop_block": np.int64, "hop_direction": np.int64, "failed_hops": np.int64, "held": np.float64}
+
+#: Offset of the thermal streams' ``initseq`` (the yield strains use 0).
+STREAM = 2**32
+
+
+def energy_unit(params, h):
+    """The unit of ``temperature``: ``G eps0^2 h^2``, the barrier of a cusp block ``eps0`` below its yield strain [energy]."""
+    return params.G * params.eps0 ** 2 * h ** 2
+
+
+def drive_scale(system):
+    """Imposed shear gamma, in eps0, per unit drive offset of the linear response (:meth:`..system.System.load`)."""
+    return float(system.delta_target[-1] / (2.0 * system.params.eps0 * system.heights[-1]))
+
+
+class HoldSchedule:
+    """When the drive is held: the slide-hold-slide protocol of the module docstring.
+
+    Parameters
+    ----------
+    hold_times : Sequence[float]
+        Hold durations, cycled [time]; empty: the drive never stops.
+    delay : float
+        Time of driving after a slip before the hold starts [time].
+
+    Attributes
+    ----------
+    started : int
+        Holds started so far (the next one lasts ``hold_times[started % len(hold_times)]``).
+    """
+
+    def __init__(self, hold_times, delay):
+        self.hold_times = tuple(hold_times)
+        self.delay = float(delay)
+        self.started = 0
+        self.start = self.end = math.inf
+
+    def hold_now(self, t, duration):
+        """Hold the drive from time ``t`` for ``duration`` (then drive on; no further holds)."""
+        self.hold_times = ()
+        self.start, self.end = t, t + duration
+
+    def slip(self, t):
+        """A slip at time ``t``: a hold that had started is over; the next one is scheduled."""
+        if t > self.start:
+            self.started += 1
+        if self.hold_times:
+            self.start = t + self.delay
+            self.end = self.start + self.hold_times[self.started % len(self.hold_times)]
+        else:
+            self.start = self.end = math.inf
+
+    def stretch(self, t):
+        """``(holding, until)``: whether the drive is held at time ``t``, and until when that lasts (``inf``: on)."""
+        if t < self.start:
+            return False, self.start
+        if t < self.end:
+            return True, self.end
+        return False, math.inf
+
+
+def _slips(table, N):
+    """Times of the stored slip events (event increments in which every block of an interface changed well)."""
+    kick = np.asarray(table["kick"], dtype=bool)
+    full = np.zeros(kick.size, dtype=bool)
+    for name in table:
+        if name.startswith("A_a"):
+            full |= np.asarray(table[name]) == N
+    return np.asarray(table["t"], dtype=np.float64)[kick & full]
+
+
+class ThermalProtocol:
+    """Thermally activated hops with a finite drive rate (module docstring).
+
+    Parameters
+    ----------
+    system : System
+        With ``params.temperature > 0``, at the last stored increment.
+    table : Mapping[str, numpy.ndarray], optional
+        The stored increment table's columns (a resumed run), None for a new run.
+    stream : int, optional
+        ``initseq`` of the random stream of increment 0 (increment ``i`` draws from ``stream + i``);
+        other values give independent replicas (:mod:`.holds`).
+    """
+
+    columns = COLUMNS
+
+    def __init__(self, system, table=None, stream=STREAM):
+        p = system.params
+        self.system = system
+        self.params = p
+        self.energy_unit = energy_unit(p, system.constants["h"])
+        self.beta = 1.0 / (p.temperature * self.energy_unit)
+        self.speed = p.drive_rate / drive_scale(system)
+        self.modes = shear_modes(system.mesh)
+        self.header = {"protocol": "thermal", "temperature": p.temperature, "attempt_rate": p.attempt_rate,
+                       "drive_rate": p.drive_rate, "hold_times": list(p.hold_times), "hold_delay": p.hold_delay,
+                       "energy_unit": self.energy_unit}
+        self.stream = int(stream)
+        self.schedule = HoldSchedule(p.hold_times, p.hold_delay / p.drive_rate)
+        self.pending = None
+        self._after = None
+        if table is not None:
+            table = {name: np.asarray(table[name]) for name in table}
+            for t in _slips(table, p.N):
+                self.schedule.slip(t)
+            if not table["kick"][-1]:
+                self.pending = (int(table["hop_block"][-1]), int(table["hop_direction"][-1]))
+
+    @staticmethod
+    def initial_row():
+        """Columns of increment 0."""
+        return {"hop_block": -1, "hop_direction": 0, "failed_hops": 0, "held": 0.0}
+
+    def _stream(self, increment):
+        state, inc = pcg32_seed(np.array([self.params.seed], dtype=np.uint64),
+                                np.array([self.stream + increment], dtype=np.uint64))
+        return state, inc
+
+    def step(self, kick, margin, increment):
+        """The next increment: a load to the next event (``kick`` False) or that event; see the module docstring."""
+        if kick:
+            return self._event(margin)
+        return self._load(margin, increment)
+
+    def _load(self, margin, increment):
+        system = self.system
+        model, state = system.model, system.state
+        start = system.snapshot()
+        t = start[3]
+        stream = self._stream(increment)
+        ds_c = system.step_size(False)
+        allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
+        ds, held, failed = 0.0, 0.0, 0
+        while True:
+            holding, until = self.schedule.stretch(t)
+            speed = 0.0 if holding else self.speed
+            kind, block, direction, dt = sample_event(
+                model.law, model.epsy, state.idx, state.eps, system.delta_eps, model.iface_dV, allowed, self.beta,
+                self.params.attempt_rate, ds, speed, until - t, ds_c, *stream)
+            if holding:
+                held += dt
+            else:
+                ds += speed * dt
+            if kind == NONE:
+                t = until
+                continue
+            t += dt
+            sign = 1 if direction == FORWARD else -1
+            if kind != HOP:
+                system.event_step(False)
+                state.t[0] = t
+                self.pending = (-1, 0)
+                return {"yield_element": False, "hop_block": -1, "hop_direction": 0, "failed_hops": failed,
+                        "held": held}
+            system.load(ds)
+            state.t[0] = t
+            loaded = system.snapshot()
+            if hop(system, self.modes, block, direction, margin):
+                state.t[0] = t  # avalanches take no time
+                self._after = system.snapshot()
+                system.restore(*loaded)
+                self.pending = (block, sign)
+                return {"yield_element": False, "hop_block": block, "hop_direction": sign, "failed_hops": failed,
+                        "held": held}
+            failed += 1
+            allowed[block, direction] = False
+            system.restore(*start)
+
+    def _event(self, margin):
+        system = self.system
+        block, sign = self.pending
+        t = float(system.state.t[0])
+        yield_element = False
+        if block < 0:
+            converged, yield_element = system.kick(margin)
+            system.state.t[0] = t
+        else:
+            if self._after is None:  # resumed at the load increment: redo the hop drawn there
+                if not hop(system, self.modes, block, FORWARD if sign > 0 else BACKWARD, margin):
+                    from ..system import SolverError
+
+                    raise SolverError(f"the stored hop of block {block} fell back when redone")
+                system.state.t[0] = t
+                self._after = system.snapshot()
+            system.restore(*self._after)
+        self.pending, self._after = None, None
+        return {"yield_element": yield_element, "hop_block": block, "hop_direction": sign, "failed_hops": 0,
+                "held": 0.0}
+
+    def stored(self, row):
+        """After an event increment: a slip (``A_a == N`` for some interface) starts a hold."""
+        if row["kick"] and any(row[name] == self.params.N for name in row if name.startswith("A_a")):
+            self.schedule.slip(row["t"])
