@@ -61,7 +61,8 @@ def test_a_producer_with_other_parameters_writes_a_readable_file(tmp_path):
         with pytest.raises(FileFormatError, match="increment 3 is not stored"):
             run.state(3)
     assert formats.describe("fem-run", path) == {"n": 1, "plates": 2, "blocks": 9, "k_drive": 0.5, "phi": 5e-7,
-                                                  "regime": "compliant", "seed": 3}
+                                                  "regime": "compliant", "seed": 3, "temperature": 0.0,
+                                                  "attempt_rate": None, "drive_rate": None}  # an athermal producer
 
 
 def test_rows_beyond_nstored_are_dropped_by_rewrite(tmp_path):
