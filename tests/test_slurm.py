@@ -49,10 +49,15 @@ def cluster(tmp_path_factory):
 
 
 def start_snakemake(directory, env, *args):
-    """Start snakemake in ``directory`` in its own process group; its output goes to ``directory``/snakemake.log."""
+    """Start snakemake in ``directory`` as a terminal starts a command; its output goes to ``directory``/snakemake.log.
+
+    It gets its own process group, and SIGINT at its default action whatever this process inherited: a
+    shell ignores SIGINT in what it starts in the background (``pytest &``, ``nohup``), and a Python
+    started so never raises ``KeyboardInterrupt``, so Ctrl-C could not be tested.
+    """
     with open(directory / "snakemake.log", "w") as log:
-        return subprocess.Popen(["snakemake", *args], cwd=directory, env=env, stdout=log, stderr=subprocess.STDOUT,
-                                start_new_session=True)
+        return subprocess.Popen(["env", "--default-signal=INT", "snakemake", *args], cwd=directory, env=env,
+                                stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
 
 def finish(process, directory, timeout):
@@ -69,7 +74,7 @@ def finish(process, directory, timeout):
         os.killpg(process.pid, signal.SIGKILL)
         process.wait()
         output = (directory / "snakemake.log").read_text()
-        pytest.fail(f"snakemake {' '.join(process.args[1:])} still running after {timeout} s (a hang):\n"
+        pytest.fail(f"{' '.join(process.args)} still running after {timeout} s (a hang):\n"
                     f"{output[-4000:]}")
     return process.returncode, (directory / "snakemake.log").read_text()
 
