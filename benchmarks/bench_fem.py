@@ -18,8 +18,8 @@ along an affine shear instead of the linear response: the cost of a step does no
 ``--event``: ``--events`` consecutive events (elastic load step, kick, minimisation with
 the whole-element fallback, i.e. two increments of the protocol) from one seed, once with
 ``relaxation = dynamic`` on the ``assembled`` backend (the solver before issue 8) and
-once with ``exact`` on the ``structured`` one (both start from the same linear response,
-solved directly). Prints per relaxation the total and median time steps and
+once with ``exact`` on the ``structured`` one (both start from the same linear response, the
+first run's). Prints per relaxation the total and median time steps and
 the wall time per event (mean and median), for all events and by size ``A`` (blocks whose Gauss point 0
 changed well, all interfaces), and last
 ``steps_ratio=<dynamic/exact, all> small_steps_ratio=<dynamic/exact, A < 10>
@@ -37,12 +37,16 @@ import time
 import numpy as np
 
 from stickslip.fem.backends import make_backend
-from stickslip.fem.dynamics import _correct, _predict, residual, time_step
+from stickslip.fem.backends.cpu.dynamics import _correct, _predict, residual
+from stickslip.fem.backends.cpu.forces import drive_force, interface_forces
+from stickslip.fem.backends.cpu.plates import plate_force
+from stickslip.fem.constants import derived_constants
 from stickslip.fem.event_driven import autoscale
-from stickslip.fem.forces import drive_force, interface_forces
-from stickslip.fem.plates import plate_force
+from stickslip.fem.linear_response import LinearResponse
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.system import System
+from stickslip.fem.simulation import Simulation
+from stickslip.fem.stack import build_stack
+from stickslip.fem.yield_strains import interface_initstate, narrowest_well
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.numba_options import njit, set_num_threads
 
@@ -50,43 +54,37 @@ from stickslip.numba_options import njit, set_num_threads
 SMALL = 10
 
 
-@njit
-def _steps(model, work, state, n):
-    for _ in range(n):
-        time_step(model, work, state)
+def _affine_response(params, mesh):
+    """An affine simple shear (gamma = eps0) as the loading direction, scaled like the true response."""
+    stack = build_stack(params, mesh, make_backend(params.backend), derived_constants(params, mesh))
+    u = np.zeros(stack.model.ndof)
+    u[mesh.dofs[:, 0]] = 2.0 * params.eps0 * mesh.coor[:, 1]
+    target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height)
+    stack.backend.set_state(u, target, 0.0, 0.0)
+    eps = stack.backend.read("eps")[0].copy()
+    scale = autoscale(narrowest_well(interface_initstate(params.seed, mesh.N, mesh.n_interfaces), params.nchunk,
+                                     params.eps0, params.eps_offset, params.weibull_k), eps)
+    return LinearResponse(scale * u, scale * eps, scale * target, 0.0)
 
 
-def _affine_response(system):
-    """Set an affine simple shear (gamma = eps0) as the loading direction, scaled like the true response."""
-    u = np.zeros(system.model.ndof)
-    eps0 = system.params.eps0
-    u[system.mesh.dofs[:, 0]] = 2.0 * eps0 * system.mesh.coor[:, 1]
-    system.restore(u, 2.0 * eps0 * system.heights, 0.0, 0.0)
-    eps = system.state.eps.copy()
-    scale = autoscale(system.narrowest_well, eps)
-    system.set_linear_response(scale * u, scale * eps, scale * 2.0 * eps0 * system.heights, 0.0)
-    system.restore(np.zeros(system.model.ndof), np.zeros(system.mesh.nlayer), 0.0, 0.0)
-
-
-def _loaded_system(args, mesh, threads, backend):
-    """A system right after a kick (blocks yielding), loaded along an affine shear, and its wells before the kick."""
-    system = System(FemParams(N=args.N, plates=args.plates, nchunk=200, backend=backend), mesh,
-                    make_backend(backend, threads))
-    _affine_response(system)
-    system.event_step(kick=False)
-    index = system.state.idx.copy()
-    system.event_step(kick=True)
-    return system, index
+def _loaded_simulation(args, mesh, threads, backend):
+    """A simulation right after a kick (blocks yielding), loaded along an affine shear, and its wells before the kick."""
+    params = FemParams(N=args.N, plates=args.plates, nchunk=200, backend=backend)
+    sim = Simulation(params, mesh, make_backend(backend, threads), response=_affine_response(params, mesh))
+    sim.loading.step(kick=False)
+    index = sim.stack.backend.read("idx")[0].copy()
+    sim.loading.step(kick=True)
+    return sim, index
 
 
 def _time_steps(args, mesh, threads, backend):
-    system, index = _loaded_system(args, mesh, threads, backend)
-    work = system.backend.work
-    _steps(system.model, work, system.state, 10)  # warm up (compiles if not cached)
+    sim, index = _loaded_simulation(args, mesh, threads, backend)
+    cpu_backend = sim.stack.backend
+    cpu_backend.advance(10)  # warm up (compiles if not cached)
     start, cpu = time.perf_counter(), time.process_time()
-    _steps(system.model, work, system.state, args.steps)
+    cpu_backend.advance(args.steps)
     seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
-    yielded = int(np.count_nonzero(system.state.idx != index))
+    yielded = int(np.count_nonzero(cpu_backend.read("idx")[0] != index))
     per_step = seconds / args.steps * 1e6
     print(f"{backend}: steps={args.steps} seconds={seconds:.3f} gauss_points_yielded={yielded} "
           f"time_per_step_us={per_step:.1f} cpu_per_step_us={cpu / args.steps * 1e6:.1f} "
@@ -138,13 +136,14 @@ def _breakdown(args, mesh, threads):
                   ("predict", _repeat_predict), ("correct", _repeat_correct), ("residual", _repeat_residual))
     repeat = max(1, args.steps // 4)
     for backend in ("assembled", "structured"):
-        system, _ = _loaded_system(args, mesh, threads, backend)
+        cpu_backend = _loaded_simulation(args, mesh, threads, backend)[0].stack.backend
+        model, work, state = cpu_backend.model, cpu_backend.work, cpu_backend.state
         parts = []
         for name, kernel in components:
             if backend == "structured" or name == "plates":
-                kernel(system.model, system.backend.work, system.state, 2)  # compile if not cached
+                kernel(model, work, state, 2)  # compile if not cached
                 start, cpu = time.perf_counter(), time.process_time()
-                kernel(system.model, system.backend.work, system.state, repeat)
+                kernel(model, work, state, repeat)
                 parts.append(f"{name}={(time.perf_counter() - start) / repeat * 1e6:.1f}/"
                              f"{(time.process_time() - cpu) / repeat * 1e6:.1f}")
         print(f"breakdown {backend} (us per step, wall/cpu): " + " ".join(parts))
@@ -160,21 +159,22 @@ def _per_step(args, mesh, threads):
     print(f"time_per_step_us={structured:.1f}")
 
 
-def _events(system, count):
+def _events(sim, count):
     """Run ``count`` events; returns arrays (steps, seconds, A) per event."""
     steps, seconds, sizes = [], [], []
-    dt = system.model.dt
+    stack = sim.stack
+    dt = stack.model.dt
     for _ in range(count):
-        system.event_step(kick=False)
-        before = system.state.idx[:, 0].copy()
-        t0 = system.state.t[0]
+        sim.loading.step(kick=False)
+        before = stack.well_index()[:, 0]
+        t0 = stack.time
         start = time.perf_counter()
-        converged, _ = system.kick(system.params.margin)
+        converged, _ = sim.protocol.kick(sim.params.margin)
         seconds.append(time.perf_counter() - start)
         if not converged:
             raise SystemExit("a block reached the end of its yield strains: use fewer --events or a larger --nchunk")
-        steps.append(int(round((system.state.t[0] - t0) / dt)))
-        sizes.append(int(np.count_nonzero(system.state.idx[:, 0] != before)))
+        steps.append(int(round((stack.time - t0) / dt)))
+        sizes.append(int(np.count_nonzero(stack.well_index()[:, 0] != before)))
     return np.array(steps), np.array(seconds), np.array(sizes)
 
 
@@ -195,16 +195,15 @@ def _event_mode(args, mesh, threads):
     for relaxation, backend in (("dynamic", "assembled"), ("exact", "structured")):
         params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, nchunk=args.nchunk, seed=args.seed,
                            relaxation=relaxation, backend=backend)
-        system = System(params, mesh, make_backend(backend, threads))
         if response is None:
-            exact = System(params, mesh, make_backend(backend, threads))
             start = time.perf_counter()
-            exact.compute_linear_response()
-            print(f"linear response (direct solve, includes compilation): {time.perf_counter() - start:.2f} s")
-            response = (exact.delta_u, exact.delta_eps, exact.delta_target, exact.delta_lever)
-        system.set_linear_response(*response)
-        _ = system.equilibrium  # factorise outside the timing (once per run)
-        runs[relaxation] = _events(system, args.events)
+            response = Simulation(params, mesh, make_backend(backend, threads)).loading.response
+            print(f"linear response (the first run's relaxation, includes compilation): "
+                  f"{time.perf_counter() - start:.2f} s")
+        sim = Simulation(params, mesh, make_backend(backend, threads), response=response)
+        if relaxation == "exact":
+            _ = sim.relaxation.equilibrium  # factorise outside the timing (once per run)
+        runs[relaxation] = _events(sim, args.events)
         _summary(relaxation, *runs[relaxation])
     dyn, fast = runs["dynamic"], runs["exact"]
     same = int(np.argmin(dyn[2] == fast[2])) if not np.array_equal(dyn[2], fast[2]) else args.events
@@ -220,18 +219,16 @@ def _compile_kernels():
     """Run a few events of a small system with both relaxations (compiles every kernel not cached)."""
     for relaxation in ("dynamic", "exact"):
         for backend in ("assembled", "structured"):
-            warm = System(FemParams(N=9, plates=2, nchunk=200, relaxation=relaxation, backend=backend),
-                          build_stack_mesh(MeshParams(N=9)), make_backend(backend))
-            warm.compute_linear_response()
+            warm = Simulation(FemParams(N=9, plates=2, nchunk=200, relaxation=relaxation, backend=backend),
+                              build_stack_mesh(MeshParams(N=9)), make_backend(backend))
             _events(warm, 3)
 
 
 def _linear_response_mode(args, mesh, threads):
     _compile_kernels()
-    system = System(FemParams(N=args.N, plates=args.plates, nchunk=args.nchunk, relaxation="exact"), mesh,
-                    make_backend("structured", threads))
     start = time.perf_counter()
-    system.compute_linear_response()
+    Simulation(FemParams(N=args.N, plates=args.plates, nchunk=args.nchunk, relaxation="exact"), mesh,
+               make_backend("structured", threads))
     print(f"linear_response_s={time.perf_counter() - start:.2f}")
 
 

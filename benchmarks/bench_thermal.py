@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from stickslip.events.extraction import classify_increments
-from stickslip.formats.fem_run import read_increments
+from stickslip.formats.fem_run import RunFile, read_increments
+from stickslip.h5io import open_file
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.replay import EventReplay
 from stickslip.fem.thermal import drive_scale, energy_unit, sample_event
@@ -51,18 +52,20 @@ def describe(label, path, wall, cpu, N):
 def draw_cost(path, draws):
     """Median cost of one :func:`sample_event` from the last stored state of a thermal run [s]."""
     replay = EventReplay(path)
-    system = replay.system
-    system.restore(*replay._state(replay.nstored - 1))
-    p, model, state = system.params, system.model, system.state
-    beta = 1.0 / (p.temperature * energy_unit(p, system.constants["h"]))
-    speed = p.drive_rate / drive_scale(system)
-    ds_c = system.step_size(False)
+    sim = replay.simulation
+    with open_file(path) as file:
+        sim.stack.restore(*RunFile(file).state(replay.nstored - 1))
+    p, model = sim.params, sim.stack.model
+    idx, eps = sim.stack.backend.read("idx", "eps")
+    beta = 1.0 / (p.temperature * energy_unit(p, sim.constants["h"]))
+    speed = p.drive_rate / drive_scale(sim.loading.response, p.eps0, sim.mesh)
+    ds_c = sim.loading.step_size(False)
     allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
     times = []
     for k in range(draws):
         stream = pcg32_seed(np.array([1], dtype=np.uint64), np.array([k], dtype=np.uint64))
         start = time.perf_counter()
-        sample_event(model.law, model.epsy, state.idx, state.eps, system.delta_eps, model.iface_dV, allowed, beta,
+        sample_event(model.law, model.epsy, idx, eps, sim.loading.response.delta_eps, model.iface_dV, allowed, beta,
                      p.attempt_rate, 0.0, speed, np.inf, ds_c, *stream)
         times.append(time.perf_counter() - start)
     return float(np.median(times))

@@ -20,11 +20,10 @@ import argparse
 
 import numpy as np
 
-from stickslip.fem.dynamics import residual
-from stickslip.fem.observables import Observer
 from stickslip.fem.backends import make_backend
+from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.system import System
+from stickslip.fem.simulation import Simulation
 from stickslip.mesh import MeshParams, build_stack_mesh
 
 
@@ -36,19 +35,19 @@ def main(argv=None):
     parser.add_argument("--increments", type=int, default=40)
     args = parser.parse_args(argv)
     params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, relaxation="exact", seed=1)
-    system = System(params, build_stack_mesh(MeshParams(N=args.N, plates=args.plates)), make_backend())
-    system.compute_linear_response()
-    observer = Observer(system)
+    sim = Simulation(params, build_stack_mesh(MeshParams(N=args.N, plates=args.plates)), make_backend())
+    stack = sim.stack
+    observer = Observer(sim)
     start = observer.well_index()
     for _ in range(args.increments // 2):
-        system.event_step(False)
-        system.kick(params.margin)
+        sim.loading.step(False)
+        sim.protocol.kick(params.margin)
     hops = observer.well_index() - start
     slips = max(int(np.sum(hops.min(axis=1) > 0)), 1)
-    top = float(system.state.ubar[-1])
+    top = float(stack.backend.read("ubar")[0][-1])
     per_slip = top / max(hops.min(axis=1).sum(), 1)  # top-plate displacement per well hop of a whole interface
-    u, target, lever, t = system.snapshot()
-    x = system.mesh.dofs[:, 0]
+    u, target, lever, t = stack.stored()
+    x = sim.mesh.dofs[:, 0]
     base = observer.observe(observer.well_index())
     print(f"N={args.N} plates={args.plates}: top plate moved {top:.3e} in {hops.min(axis=1).sum()} "
           f"interface-wide well hops ({per_slip:.3e} per hop; slips >= {slips})")
@@ -57,13 +56,13 @@ def main(argv=None):
     for T in [0.0, 1.0, 1e1, 1e2, 1e3, 1e4, 1e5]:
         moved = u.copy()
         moved[np.unique(x)] += T
-        system.restore(moved, target + T, lever, t)
-        r = residual(system.model, system.state)
+        stack.restore(moved, target + T, lever, t)
+        r = stack.backend.residual()
         row = observer.observe(observer.well_index())
         dsig = abs(row["sigd"] / base["sigd"] - 1.0)
         drive = [k for k in row if k.startswith("fxdrive_") and base[k] != 0.0]
         dfx = max(abs(row[k] / base[k] - 1.0) for k in drive)
-        solved = system.relax_in_wells()
+        solved = sim.relaxation.solve_in_wells(stack.backend)
         print(f"{T:8.0e} {T / per_slip:10.2e} {r:10.2e} {dsig:10.2e} {dfx:10.2e} {'ok' if solved else 'FAILS'}")
         if floor_T is None and r > 1e-10:
             floor_T = T

@@ -62,7 +62,7 @@ from stickslip.fem.backends import make_backend
 from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.stiffness import stiffness_ratio
-from stickslip.fem.system import System
+from stickslip.fem.simulation import Simulation
 from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
 from stickslip.mesh import MeshParams, build_stack_mesh
@@ -71,19 +71,19 @@ from stickslip.params import parse_params
 REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "nchunk": 200}
 
 
-def _increments(system, count):
+def _increments(sim, count):
     """The protocol's increments (load step, kick) until the margin stop or ``count`` kicks; rows of observables."""
-    observer = Observer(system)
+    observer = Observer(sim)
     previous = observer.well_index()
     rows = []
-    margin = system.params.margin
+    margin = sim.params.margin
     for _ in range(count):
-        system.event_step(False)
-        if not (system.state.idx < system.model.epsy.shape[1] - margin).all():
+        sim.loading.step(False)
+        if not sim.stack.within_margin(margin):
             break
         rows.append(observer.observe(previous))
         previous = observer.well_index()
-        if not system.kick(margin)[0]:
+        if not sim.protocol.kick(margin)[0]:
             break
         rows.append(observer.observe(previous))
         previous = observer.well_index()
@@ -93,16 +93,13 @@ def _increments(system, count):
 def reference(args):
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
     case = {**REFERENCE_CASE, "tol": args.tol}
-    response = System(FemParams(**case), mesh, make_backend())
-    response.compute_linear_response()
-    linear = (response.delta_u, response.delta_eps, response.delta_target, response.delta_lever)
+    linear = Simulation(FemParams(**case), mesh, make_backend()).loading.response
     out = {}
     for relaxation in ("dynamic", "exact"):
-        system = System(FemParams(**case, relaxation=relaxation), mesh, make_backend())
-        system.set_linear_response(*linear)
+        sim = Simulation(FemParams(**case, relaxation=relaxation), mesh, make_backend(), response=linear)
         start = time.perf_counter()
-        out[relaxation] = _increments(system, 1000)
-        print(f"{relaxation}: {len(out[relaxation])} increments, {system.state.t[0] / system.model.dt:.0f} time "
+        out[relaxation] = _increments(sim, 1000)
+        print(f"{relaxation}: {len(out[relaxation])} increments, {sim.stack.time / sim.stack.model.dt:.0f} time "
               f"steps, {time.perf_counter() - start:.1f} s")
     a, b = out["dynamic"], out["exact"]
     n = min(len(a), len(b))
@@ -116,13 +113,14 @@ def reference(args):
     for i in range(max(first - 2, 0), min(first + 2, n)):
         print(f"  increment {i + 1}: (S_a1, A_a1, sigd) dynamic {a[i]['S_a1']}, {a[i]['A_a1']}, {a[i]['sigd']:.9f}; "
               f"exact {b[i]['S_a1']}, {b[i]['A_a1']}, {b[i]['sigd']:.9f}")
-    system = System(FemParams(**case), mesh, make_backend())
-    system.set_linear_response(*linear)
-    system.event_step(False)
-    system.kick(system.params.margin)
-    u = system.state.u.copy()
-    assert system.relax_in_wells()
-    print(f"first kick: the dynamic end state is {np.abs(u - system.state.u).max() / np.abs(u).max():.2e} "
+    sim = Simulation(FemParams(**case), mesh, make_backend(), response=linear)
+    sim.loading.step(False)
+    sim.protocol.kick(sim.params.margin)
+    u = sim.stack.backend.read("u")[0].copy()
+    exact = Simulation(FemParams(**case, relaxation="exact"), mesh, make_backend(), response=linear).relaxation
+    assert exact.solve_in_wells(sim.stack.backend)
+    distance = np.abs(u - sim.stack.backend.read("u")[0]).max() / np.abs(u).max()
+    print(f"first kick: the dynamic end state is {distance:.2e} "
           f"(relative, max norm) from the exact equilibrium of its own wells")
 
 
@@ -205,18 +203,17 @@ def time_step_study(args):
 
 def _kick_outcomes(params, mesh, response, states):
     """Kick and minimise every stored state with ``params``; per state (S, global well indices, sigd)."""
-    system = System(FemParams(**params), mesh, make_backend())
-    system.set_linear_response(*response)
-    observer = Observer(system)
+    sim = Simulation(FemParams(**params), mesh, make_backend(), response=response)
+    observer = Observer(sim)
     out = []
     for state in states:
-        system.restore(*state)
+        sim.stack.restore(*state)
         previous = observer.well_index()
-        if not system.kick(system.params.margin)[0]:
+        if not sim.protocol.kick(sim.params.margin)[0]:
             raise SystemExit("a kick reached the margin")
         row = observer.observe(previous)
         size = sum(value for key, value in row.items() if key.startswith("S_a"))
-        out.append((size, system.well_index(), row["sigd"]))
+        out.append((size, sim.stack.well_index(), row["sigd"]))
     return out
 
 
@@ -255,36 +252,34 @@ def paired(args):
               f"{stress[same].max() if same.any() else float('nan'):.1e}")
 
 
-def _kinetic_energy(model, state):
-    free = model.mass_inv > 0
-    return 0.5 * float(np.sum(state.v[free] ** 2 / model.mass_inv[free]))
+def _kinetic_energy(backend):
+    free = backend.model.mass_inv > 0
+    return 0.5 * float(np.sum(backend.read("v")[0][free] ** 2 / backend.model.mass_inv[free]))
 
 
 def stability(args):
     """The explicit stability limit of the time step: computed, then tried after a kick."""
     mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
     params = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "relaxation": "exact"}
-    system = System(FemParams(**params), mesh, make_backend())
-    stiffness = system.equilibrium.matrix  # plates + interfaces with the elastic (stiffest) law, free DOFs
-    weight = sparse.diags(np.sqrt(system.model.mass_inv[system.equilibrium.free]))
+    sim = Simulation(FemParams(**params), mesh, make_backend())
+    equilibrium, model = sim.relaxation.equilibrium, sim.stack.model
+    stiffness = equilibrium.matrix  # plates + interfaces with the elastic (stiffest) law, free DOFs
+    weight = sparse.diags(np.sqrt(model.mass_inv[equilibrium.free]))
     omega = float(np.sqrt(eigsh(weight @ stiffness @ weight, k=1, which="LA", return_eigenvectors=False)[0]))
-    limit = 2.0 / omega / system.model.dt
+    limit = 2.0 / omega / model.dt
     print(f"omega_max = {omega:.4f} (lumped mass, elastic stiffness without the drive): velocity Verlet is "
           f"stable (undamped) for dt < 2 / omega_max = {limit:.2f} dt")
-    system.compute_linear_response()
-    response = (system.delta_u, system.delta_eps, system.delta_target, system.delta_lever)
-    system.event_step(False)
-    system.event_step(True)
-    kicked = system.snapshot()
+    sim.loading.step(False)
+    sim.loading.step(True)
+    kicked = sim.stack.stored()
     bound = np.inf  # 1e3 times the largest kinetic energy with the first dt_scale
     for scale in (*args.scales, 0.95 * limit, 1.05 * limit):
-        trial = System(FemParams(**params, dt_scale=scale), mesh, make_backend())
-        trial.set_linear_response(*response)
-        trial.restore(*kicked)
+        trial = Simulation(FemParams(**params, dt_scale=scale), mesh, make_backend(), response=sim.loading.response)
+        trial.stack.restore(*kicked)
         energy = np.empty(args.steps)
         for i in range(args.steps):
-            trial.backend.time_step(trial.model, trial.state)
-            energy[i] = _kinetic_energy(trial.model, trial.state)
+            trial.stack.backend.advance(1)
+            energy[i] = _kinetic_energy(trial.stack.backend)
             if not energy[i] < bound:
                 break
         stable = i + 1 == args.steps

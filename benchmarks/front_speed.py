@@ -42,7 +42,8 @@ from stickslip.events import fronts
 from stickslip.events.extraction import classify_increments
 from stickslip.fem.backends import make_backend
 from stickslip.fem.parameters import stored_params
-from stickslip.fem.system import System
+from stickslip.fem.loading import KickAlongResponse
+from stickslip.fem.simulation import Simulation
 from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
 from stickslip.mesh import interface_layer
@@ -61,12 +62,13 @@ def replays(path, scales, max_events):
         states = {int(i): (run.state(int(i) - 1), run.state(int(i))) for i in chosen}
     yield_element = table["yield_element"].to_numpy(dtype=bool)
     for scale in scales:
-        system = System(dataclasses.replace(params, dt_scale=float(scale)), mesh, make_backend(params.backend))
-        system.set_linear_response(*response)
+        sim = Simulation(dataclasses.replace(params, dt_scale=float(scale)), mesh, make_backend(params.backend),
+                         response=response)
         for increment, (before, after) in states.items():
-            system.restore(*before)
-            _, events = system.kick_and_minimise(bool(yield_element[increment]), params.margin, record=True)
-            reproduced = bool(np.array_equal(system.state.u, after[0]))
+            sim.stack.restore(*before)
+            kick = KickAlongResponse(sim.loading, bool(yield_element[increment]))
+            _, events = sim.protocol.perturb_and_relax(kick, params.margin, record=True)
+            reproduced = bool(np.array_equal(sim.stack.backend.read("u")[0], after[0]))
             element = events[:, 0].astype(np.int64)
             failures = pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - before[3],
                                      "direction": events[:, 2].astype(np.int64)})

@@ -29,7 +29,7 @@ import dataclasses
 import difflib
 import math
 import typing
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 
 __all__ = [
     "ParameterError",
@@ -59,8 +59,10 @@ def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, ex
         One-line description, shown by ``stickslip plugins --params``.
     unit : str, optional
         Physical unit ("" for dimensionless or not applicable).
-    choices : sequence, optional
-        The allowed values.
+    choices : sequence or Mapping, optional
+        The allowed values. A mapping (a plugin's registry, name -> class) is kept as it is, so that
+        what is registered later is allowed too; ``stickslip plugins --params`` then shows each name
+        with its class's ``summary``.
     minimum, maximum : float, optional
         Inclusive bounds (for tuples: of every element).
     exclusive_minimum : float, optional
@@ -74,7 +76,9 @@ def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, ex
     -------
     dataclasses.Field
     """
-    meta = {"doc": doc, "unit": unit, "choices": tuple(choices) if choices is not None else None,
+    if choices is not None and not isinstance(choices, Mapping):
+        choices = tuple(choices)
+    meta = {"doc": doc, "unit": unit, "choices": choices,
             "minimum": minimum, "maximum": maximum, "exclusive_minimum": exclusive_minimum,
             "extension": extension if isinstance(extension, str) else bool(extension)}
     return dataclasses.field(default=default, metadata=meta)
@@ -325,7 +329,12 @@ def describe(cls):
         if typing.get_origin(annotation) is tuple:
             type_name = f"tuple[{typing.get_args(annotation)[0].__name__}]"
         doc = f.metadata.get("doc", "")
-        if f.metadata.get("choices") is not None:
-            doc += f" (one of: {', '.join(map(str, f.metadata['choices']))})"
+        choices = f.metadata.get("choices")
+        if isinstance(choices, Mapping):
+            listed = "; ".join(f"{name}: {entry.summary}" if getattr(entry, "summary", "") else name
+                               for name, entry in choices.items())
+            doc += f" (one of: {listed})"
+        elif choices is not None:
+            doc += f" (one of: {', '.join(map(str, choices))})"
         rows.append((f.name, type_name, f.default, f.metadata.get("unit", ""), doc))
     return rows

@@ -7,14 +7,18 @@ import numpy as np
 import pytest
 
 from stickslip.fem.backends import make_backend
+from stickslip.fem.backends.cpu.forces import compute_force
+from stickslip.fem.backends.cpu.state import new_state
 from stickslip.fem.event_driven import step_size
+from stickslip.fem.laws import INTERFACE_LAWS, Cusp, well_index, well_stress
+from stickslip.fem.linear_response import compute_linear_response
 from stickslip.fem.materials import equivalent_strain
-from stickslip.fem.model import build_model, new_state
+from stickslip.fem.model import build_model
 from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
+from stickslip.fem.quad4 import element_strain
 from stickslip.fem.random import pcg32_uint32, pcg32_uniform
-from stickslip.fem.system import System
-from stickslip.fem.laws import LAWS, Cusp
+from stickslip.fem.simulation import Simulation
 from stickslip.fem.yield_strains import interface_initstate, yield_strains
 from stickslip.mesh import MeshParams, build_stack_mesh
 
@@ -44,69 +48,76 @@ def test_yield_strains_statistics_and_seeding():
 
 
 @pytest.fixture(scope="module")
-def stack():
-    """A 3-plate stack with coarsening rows (N = 18)."""
+def sim():
+    """A 3-plate stack with coarsening rows (N = 18), at rest at the origin."""
     mesh = build_stack_mesh(MeshParams(N=18, plates=3))
-    return System(FemParams(N=18, plates=3, nchunk=50), mesh, make_backend())
+    return Simulation(FemParams(N=18, plates=3, nchunk=50), mesh, make_backend())
 
 
-def test_homogeneous_simple_shear_gives_the_shear_modulus(stack):
+def _drive_at_rest(sim, u):
+    """Set displacement ``u`` with the drive springs at rest (targets at the layer averages)."""
+    sim.stack.restore(u, np.zeros(sim.mesh.nlayer), 0.0, 0.0)
+    sim.stack.restore(u, sim.stack.backend.read("ubar")[0].copy(), 0.0, 0.0)
+    return sim.stack.backend.read("f")[0]
+
+
+def test_homogeneous_simple_shear_gives_the_shear_modulus(sim):
     gamma = 1e-6
-    y = stack.mesh.coor[:, 1]
-    u = np.zeros(stack.model.ndof)
-    u[stack.mesh.dofs[:, 0]] = 2.0 * gamma * y
-    stack.restore(u, np.zeros(stack.mesh.nlayer), 0.0, 0.0)
-    stack.restore(u, stack.state.ubar.copy(), 0.0, 0.0)  # drive springs at rest
-    f = stack.state.f
+    mesh, model = sim.mesh, sim.stack.model
+    y = mesh.coor[:, 1]
+    u = np.zeros(model.ndof)
+    u[mesh.dofs[:, 0]] = 2.0 * gamma * y
+    f = _drive_at_rest(sim, u)
     # patch test: a homogeneous stress is in equilibrium at every interior node, transition rows included
-    top = stack.mesh.coor[:, 1] == stack.mesh.coor[:, 1].max()
-    interior = np.ones(stack.model.ndof, dtype=bool)
-    interior[stack.mesh.dofs[top].ravel()] = False
-    interior[stack.model.prescribed] = False
+    top = mesh.coor[:, 1] == mesh.coor[:, 1].max()
+    interior = np.ones(model.ndof, dtype=bool)
+    interior[mesh.dofs[top].ravel()] = False
+    interior[model.prescribed] = False
     assert np.abs(f[interior]).max() < 1e-12 * np.abs(f).max()
     # energy G eps_eq^2 V, eps_eq = gamma
-    volume = stack.model.layer_volume.sum()
-    assert 0.5 * u @ stack.state.f == pytest.approx(stack.params.G * gamma**2 * volume, rel=1e-10)
-    row = Observer(stack).observe(Observer(stack).well_index())
-    for layer in range(stack.mesh.nlayer):  # sigma_eq = 2 G gamma, eps_eq = gamma, in units 2 G eps0 and eps0
-        assert row[f"sigd_{layer}"] == pytest.approx(gamma / stack.params.eps0, rel=1e-10)
-        assert row[f"epsd_{layer}"] == pytest.approx(gamma / stack.params.eps0, rel=1e-10)
-        assert row[f"ubar_{layer}"] == pytest.approx(2 * gamma * stack.heights[layer], rel=1e-10)
+    volume = model.layer_volume.sum()
+    assert 0.5 * u @ f == pytest.approx(sim.params.G * gamma**2 * volume, rel=1e-10)
+    observer = Observer(sim)
+    row = observer.observe(observer.well_index())
+    for layer in range(mesh.nlayer):  # sigma_eq = 2 G gamma, eps_eq = gamma, in units 2 G eps0 and eps0
+        assert row[f"sigd_{layer}"] == pytest.approx(gamma / sim.params.eps0, rel=1e-10)
+        assert row[f"epsd_{layer}"] == pytest.approx(gamma / sim.params.eps0, rel=1e-10)
+        assert row[f"ubar_{layer}"] == pytest.approx(2 * gamma * mesh.layer_mid_height[layer], rel=1e-10)
 
 
-def test_uniaxial_strain_gives_bulk_and_shear_energy(stack):
+def test_uniaxial_strain_gives_bulk_and_shear_energy(sim):
     eps = 1e-6
-    u = np.zeros(stack.model.ndof)
-    u[stack.mesh.dofs[:, 1]] = eps * stack.mesh.coor[:, 1]
-    stack.restore(u, np.zeros(stack.mesh.nlayer), 0.0, 0.0)
-    stack.restore(u, stack.state.ubar.copy(), 0.0, 0.0)
+    u = np.zeros(sim.stack.model.ndof)
+    u[sim.mesh.dofs[:, 1]] = eps * sim.mesh.coor[:, 1]
+    f = _drive_at_rest(sim, u)
     # eps_m = eps / 2, eps_eq = eps / 2: U = (K + G) eps^2 / 4
-    expected = (stack.params.K + stack.params.G) * eps**2 / 4 * stack.model.layer_volume.sum()
-    assert 0.5 * u @ stack.state.f == pytest.approx(expected, rel=1e-10)
+    expected = (sim.params.K + sim.params.G) * eps**2 / 4 * sim.stack.model.layer_volume.sum()
+    assert 0.5 * u @ f == pytest.approx(expected, rel=1e-10)
 
 
-def _undamped_energy_error(system, dt, nsteps):
-    model = system.model._replace(damping=np.zeros(system.model.ndof), dt=dt,
-                                  drive_active=np.zeros_like(system.model.drive_active))
-    state = new_state(model)
-    x, y = system.mesh.coor[:, 0], system.mesh.coor[:, 1]
-    L, H = system.mesh.N * system.mesh.h, y.max()
-    state.u[system.mesh.dofs[:, 0]] = 1e-6 * np.sin(2 * np.pi * x / L) * np.sin(np.pi * y / H)
-    backend = system.backend
-    backend.force(model, state)
+def _undamped_energy_error(sim, dt, nsteps):
+    model = sim.stack.model._replace(damping=np.zeros(sim.stack.model.ndof), dt=dt,
+                                     drive_active=np.zeros_like(sim.stack.model.drive_active))
+    backend = sim.stack.backend.for_model(model)
+    x, y = sim.mesh.coor[:, 0], sim.mesh.coor[:, 1]
+    L, H = sim.mesh.N * sim.mesh.h, y.max()
+    u = np.zeros(model.ndof)
+    u[sim.mesh.dofs[:, 0]] = 1e-6 * np.sin(2 * np.pi * x / L) * np.sin(np.pi * y / H)
+    backend.set_state(u, np.zeros(sim.mesh.nlayer), 0.0, 0.0)
     mass = np.where(model.mass_inv > 0, 1.0 / np.where(model.mass_inv > 0, model.mass_inv, 1.0), 0.0)
     energies = []
     for _ in range(nsteps):
-        backend.time_step(model, state)
-        energies.append(0.5 * mass @ state.v**2 + 0.5 * state.u @ state.f)
+        backend.advance(1)
+        u, v, f = backend.read("u", "v", "f")
+        energies.append(0.5 * mass @ v**2 + 0.5 * u @ f)
     energies = np.array(energies)
     return np.abs(energies - energies[0]).max() / energies[0]
 
 
-def test_undamped_dynamics_conserves_energy_to_second_order(stack):
-    dt = stack.model.dt
-    coarse = _undamped_energy_error(stack, dt, 1000)
-    fine = _undamped_energy_error(stack, dt / 2, 2000)
+def test_undamped_dynamics_conserves_energy_to_second_order(sim):
+    dt = sim.stack.model.dt
+    coarse = _undamped_energy_error(sim, dt, 1000)
+    fine = _undamped_energy_error(sim, dt / 2, 2000)
     assert coarse < 1e-3
     assert 3.0 < coarse / fine < 5.0  # O(dt^2)
 
@@ -135,78 +146,77 @@ def test_shear_pulse_travels_at_the_shear_wave_speed():
                         drive_active=np.array([False]), free_lever=False, lever_height=1.0)
     backend = make_backend().prepare(model, mesh)
     c_s = math.sqrt(1.0 / 2.0 / 1.0)
-    state = new_state(model)
     y = mesh.coor[:, 1]
     y0, width = 100 * h, 12 * h
     profile = np.exp(-(((y - y0) / width) ** 2))
-    state.u[mesh.dofs[:, 0]] = 1e-6 * profile
-    state.v[mesh.dofs[:, 0]] = 1e-6 * 2 * (y - y0) / width**2 * profile * c_s  # u(y - c_s t)
+    u = np.zeros(model.ndof)
+    u[mesh.dofs[:, 0]] = 1e-6 * profile
+    backend.set_state(u, np.zeros(1), 0.0, 0.0)
+    state = backend.state  # a CPU backend's own arrays: the initial velocity of the pulse u(y - c_s t)
+    state.v[mesh.dofs[:, 0]] = 1e-6 * 2 * (y - y0) / width**2 * profile * c_s
     state.v[model.prescribed] = 0.0
-    backend.force(model, state)
     column = mesh.dofs[mesh.coor[:, 0] == 0, 0]
     ycol = y[mesh.coor[:, 0] == 0]
 
     def centre():
-        w = state.u[column] ** 2
+        w = backend.read("u")[0][column] ** 2
         return (w * ycol).sum() / w.sum()
 
     start = centre()
     nsteps = 4000
-    for _ in range(nsteps):
-        backend.time_step(model, state)
+    backend.advance(nsteps)
     speed = (centre() - start) / (nsteps * model.dt)
     assert speed == pytest.approx(c_s, rel=0.01)
 
 
-def test_linear_response_and_load_step_superpose(stack):
-    s = stack
-    s.restore(np.zeros(s.model.ndof), np.zeros(s.mesh.nlayer), 0.0, 0.0)
-    s.compute_linear_response()
+def test_linear_response_and_load_step_superpose(sim):
+    stack, model, nlayer = sim.stack, sim.stack.model, sim.mesh.nlayer
+    backend = stack.backend
+    r = compute_linear_response(stack, sim.relaxation, sim.params, sim.mesh)
     # the response is linear: forces scale with the displacement (interfaces in their first well)
-    s.restore(3.0 * s.delta_u, 3.0 * s.delta_target, 0.0, 0.0)
-    f3 = s.state.f.copy()
-    s.restore(s.delta_u, s.delta_target, 0.0, 0.0)
-    np.testing.assert_allclose(f3, 3.0 * s.state.f, rtol=0, atol=1e-12 * np.abs(f3).max())
+    stack.restore(3.0 * r.delta_u, 3.0 * r.delta_target, 0.0, 0.0)
+    f3 = backend.read("f")[0].copy()
+    stack.restore(r.delta_u, r.delta_target, 0.0, 0.0)
+    f = backend.read("f")[0]
+    np.testing.assert_allclose(f3, 3.0 * f, rtol=0, atol=1e-12 * np.abs(f3).max())
     # and it is in equilibrium with its drive (minimised to the residual tolerance)
-    free = ~s.model.prescribed
-    assert np.linalg.norm(s.state.f[free]) < 1e-3 * np.linalg.norm(s.state.f[~free])
+    free = ~model.prescribed
+    assert np.linalg.norm(f[free]) < 1e-3 * np.linalg.norm(f[~free])
     # the load step superposes strain and stops just short of the first yield strain
-    s.restore(np.zeros(s.model.ndof), np.zeros(s.mesh.nlayer), 0.0, 0.0)
-    step = s.event_step(kick=False)
-    np.testing.assert_allclose(s.state.eps, step * s.delta_eps, rtol=0, atol=1e-12 * np.abs(s.state.eps).max())
-    eq = np.hypot(0.5 * (s.state.eps[..., 0] - s.state.eps[..., 1]), s.state.eps[..., 2])
-    ratio = eq / s.model.epsy[:, 1][:, None]
-    assert np.all(s.state.idx == 0)
+    stack.restore(np.zeros(model.ndof), np.zeros(nlayer), 0.0, 0.0)
+    step = sim.loading.step(kick=False)
+    u, eps, idx = backend.read("u", "eps", "idx")
+    np.testing.assert_allclose(eps, step * r.delta_eps, rtol=0, atol=1e-12 * np.abs(eps).max())
+    eq = np.hypot(0.5 * (eps[..., 0] - eps[..., 1]), eps[..., 2])
+    ratio = eq / model.epsy[:, 1][:, None]
+    assert np.all(idx == 0)
     assert 1.0 - 2e-5 < ratio.max() < 1.0
     # a kick makes at least one Gauss point yield, and no more than a kick's worth of strain is added
-    before = s.state.idx.copy()
-    kick = step_size(s.model.epsy, s.model.iface_dofs, s.model.iface_dNdx, s.state.u, s.delta_u, s.state.eps,
-                     s.delta_eps, before, s.constants["deps"], True, False)
-    s.event_step(kick=True)
-    assert np.any(s.state.idx != before)
-    assert kick * equivalent_strain(*s.delta_eps.reshape(-1, 3).max(axis=0)) < 10 * s.constants["deps"]
+    before = idx.copy()
+    kick = step_size(model.epsy, model.iface_dofs, model.iface_dNdx, u, r.delta_u, eps, r.delta_eps, before,
+                     sim.constants["deps"], True, False)
+    sim.loading.step(kick=True)
+    assert np.any(backend.read("idx")[0] != before)
+    assert kick * equivalent_strain(*r.delta_eps.reshape(-1, 3).max(axis=0)) < 10 * sim.constants["deps"]
 
 
-@pytest.mark.parametrize("law", sorted(LAWS))
+@pytest.mark.parametrize("law", sorted(INTERFACE_LAWS))
 @pytest.mark.parametrize("update_wells", [True, False])
 def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells, law):
     # every interface Gauss point: strain (element_strain), well (well_index) and the law's stress
     # (well_stress, its scalar reference) evaluated one by one must give the same bits as the
     # vectorised kernel, with displacements large enough that many points change well (the
     # recompute path)
-    from stickslip.fem.laws import well_index, well_stress
-    from stickslip.fem.quad4 import element_strain
-
-    system = System(FemParams(N=9, plates=3, nchunk=50, interface_law=law), build_stack_mesh(MeshParams(N=9, plates=3)),
-                    make_backend())
-    model, state = system.model, new_state(system.model)
+    backend = Simulation(FemParams(N=9, plates=3, nchunk=50, interface_law=law),
+                         build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).stack.backend
+    model, state = backend.model, new_state(backend.model)
     assert model.law.name == law
     rng = np.random.default_rng(3)
     state.u[:] = 2e-3 * rng.standard_normal(model.ndof)
     state.idx[:] = rng.integers(0, 5, state.idx.shape)
     before = state.idx.copy()
-    system.backend.force(model, state, update_wells)
-    fe = system.backend.work.iface.fe
+    compute_force(model, backend.work, state, update_wells)
+    fe = backend.work.iface.fe
     moved = 0
     for e in range(model.iface_dofs.shape[0]):
         eps = np.zeros((4, 3))

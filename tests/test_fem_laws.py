@@ -8,7 +8,7 @@ from stickslip.fem.laws import (LAWS, Cusp, Smooth, deviatoric_factor, energy_de
                                 well_stress)
 from stickslip.fem.materials import equivalent_strain
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.system import System
+from stickslip.fem.simulation import Simulation
 from stickslip.mesh import MeshParams, build_stack_mesh
 
 LO, HI = 2.0e-4, 3.1e-4  # a well [strain]: centre 2.55e-4, half-width 5.5e-5
@@ -98,34 +98,34 @@ def test_the_barrier_vanishes_as_the_square_for_the_cusp_and_the_three_halves_po
     assert forward_barrier(Smooth(4.5, 1.0), centre + 0.7 * half, LO, HI) == 0.0
 
 
-def _smooth_system(relaxation, **values):
+def _smooth_simulation(relaxation, **values):
     params = FemParams(N=9, plates=2, nchunk=200, yield_strains="stop", interface_law="smooth",
                        relaxation=relaxation, **values)
-    system = System(params, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend())
-    system.compute_linear_response()
-    return system
+    return Simulation(params, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend())
 
 
 @pytest.mark.slow
 def test_the_event_driven_protocol_and_both_relaxations_run_with_the_smooth_law():
-    dynamic, exact = _smooth_system("dynamic", tol=1e-9), _smooth_system("exact")
-    assert dynamic.model.law == Smooth(4.5, 1.0)
+    dynamic, exact = _smooth_simulation("dynamic", tol=1e-9), _smooth_simulation("exact")
+    assert dynamic.stack.model.law == Smooth(4.5, 1.0)
     for event in range(8):
         wells = []
-        for system in (dynamic, exact):
-            system.event_step(False)
-            before = system.state.idx.copy()
-            assert system.kick(5) == (True, False)
-            assert np.any(system.state.idx != before)
-            wells.append(system.state.idx.copy())
+        for sim in (dynamic, exact):
+            sim.loading.step(False)
+            before = sim.stack.well_index()
+            assert sim.protocol.kick(5) == (True, False)
+            assert np.any(sim.stack.well_index() != before)
+            wells.append(sim.stack.well_index())
         # the same event with both relaxations: the same wells, the same state up to the tolerance (the drive's
         # soft mode amplifies a residual tol into ~1e-4 of the displacement, docs/fem.md)
         np.testing.assert_array_equal(wells[0], wells[1], err_msg=f"event {event}")
         # the exact relaxation ends at rest in the current wells, with a residual below tol (tol^2, or tol
         # where the iterations stall, as for the cusp)
-        assert exact.backend.residual(exact.model, exact.state) < exact.params.tol
-        assert exact.backend.wells_hold(exact.model, exact.state)
-        assert exact.state.v.max() == exact.state.v.min() == 0.0
-        scale = np.abs(exact.state.u).max()
-        assert np.abs(dynamic.state.u - exact.state.u).max() < 1e-3 * scale
-        dynamic.restore(*exact.snapshot())  # continue both from the same state
+        backend = exact.stack.backend
+        assert backend.residual() < exact.params.tol
+        assert backend.wells_hold()
+        u, v = backend.read("u", "v")
+        assert v.max() == v.min() == 0.0
+        scale = np.abs(u).max()
+        assert np.abs(dynamic.stack.backend.read("u")[0] - u).max() < 1e-3 * scale
+        dynamic.stack.restore(*exact.stack.stored())  # continue both from the same state

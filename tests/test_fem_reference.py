@@ -4,6 +4,7 @@ import shutil
 from pathlib import Path
 
 import h5py
+import numba
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,9 +12,14 @@ import pytest
 from conftest import FEM_REFERENCE_CASE as REFERENCE_CASE
 from stickslip import registry
 from stickslip.cli import main
+from stickslip.fem.backends import make_backend
+from stickslip.fem.parameters import stored_params
 from stickslip.fem.replay import EventReplay
-from stickslip.formats.fem_run import read_increments, read_run_attrs
+from stickslip.fem.simulation import Simulation
+from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError
+from stickslip.mesh import MeshParams, build_stack_mesh
+from stickslip.numba_options import set_num_threads
 from stickslip.params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
@@ -99,19 +105,14 @@ def test_one_replay_serves_every_event_of_a_run(fem_reference_run):
 
 def _indices(path, increment):
     """Well index of Gauss point 0 of every block at ``increment - 1`` and ``increment``."""
-    from stickslip.fem.backends import make_backend
-    from stickslip.fem.parameters import stored_params
-    from stickslip.fem.system import System
-    from stickslip.formats.fem_run import RunFile
-
     with h5py.File(path) as file:
         run = RunFile(file)
         params = stored_params(file)
-        system = System(params, run.mesh, make_backend(params.backend))
+        stack = Simulation(params, run.mesh, make_backend(params.backend), response=run.linear_response()).stack
         out = []
         for inc in (increment - 1, increment):
-            system.restore(*run.state(inc))
-            out.append(system.state.idx[:, 0].copy())
+            stack.restore(*run.state(inc))
+            out.append(stack.well_index()[:, 0])
     return np.array(out)
 
 
@@ -134,13 +135,6 @@ def test_cli_rejects_bad_parameters_naming_them(tmp_path, capsys):
 
 
 def test_results_do_not_depend_on_the_number_of_threads():
-    import numba
-
-    from stickslip.fem.backends import make_backend
-    from stickslip.fem.system import System
-    from stickslip.mesh import MeshParams, build_stack_mesh
-    from stickslip.numba_options import set_num_threads
-
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("numba was started with one thread")
     plugin = registry.get("solver", "fem")
@@ -149,13 +143,11 @@ def test_results_do_not_depend_on_the_number_of_threads():
     states = []
     for threads in (1, 2):
         set_num_threads(threads)
-        system = System(params, mesh, make_backend(params.backend, threads))
-        system.compute_linear_response()
-        system.event_step(kick=False)
-        system.event_step(kick=True)
-        for _ in range(300):  # blocks yield during these steps
-            system.backend.time_step(system.model, system.state)
-        states.append(system.state)
+        sim = Simulation(params, mesh, make_backend(params.backend, threads))
+        sim.loading.step(kick=False)
+        sim.loading.step(kick=True)
+        sim.stack.backend.advance(300)  # blocks yield during these steps
+        states.append(sim.stack.backend.read("u", "v", "a", "f", "idx", "sig"))
     set_num_threads(1)
-    for name in ("u", "v", "a", "f", "idx", "sig"):
-        np.testing.assert_array_equal(getattr(states[0], name), getattr(states[1], name), err_msg=name)
+    for name, one, two in zip(("u", "v", "a", "f", "idx", "sig"), *states):
+        np.testing.assert_array_equal(one, two, err_msg=name)

@@ -5,13 +5,19 @@ import pytest
 
 from stickslip.fem.assembly import assemble_csr, elastic_element_stiffness, element_dofs
 from stickslip.fem.backends import make_backend
-from stickslip.fem.model import new_state
-from stickslip.fem.plates import plate_force
+from stickslip.fem.backends.cpu.plates import plate_force
+from stickslip.fem.backends.cpu.stencils import balanced_blocks, build_stencils, plan_product, plate_product
+from stickslip.fem.constants import derived_constants
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.quad4 import element_coordinates, shape_gradients
-from stickslip.fem.structured import balanced_blocks, build_stencils, plan_product, plate_product
-from stickslip.fem.system import System
+from stickslip.fem.stack import build_stack
 from stickslip.mesh import MeshParams, build_stack_mesh
+
+
+def _backend(mesh, name, threads=1):
+    """A CPU backend ``name`` prepared for the stack of ``mesh``."""
+    params = FemParams(N=mesh.N, plates=mesh.plates, nchunk=20)
+    return build_stack(params, mesh, make_backend(name, threads), derived_constants(params, mesh)).backend
 
 
 @pytest.mark.parametrize("plates_", [2, 3, 4, 5, 6])
@@ -19,18 +25,15 @@ from stickslip.mesh import MeshParams, build_stack_mesh
 def test_stencils_equal_the_assembled_product_on_random_displacements(N, plates_):
     # n = plates - 1 = 1..5 interfaces; random displacements reach every row, the periodic wrap included
     mesh = build_stack_mesh(MeshParams(N=N, plates=plates_))
-    systems = [System(FemParams(N=N, plates=plates_, nchunk=20), mesh, make_backend(name))
-               for name in ("structured", "assembled")]
+    backends = [_backend(mesh, name) for name in ("structured", "assembled")]
     rng = np.random.default_rng(N * 10 + plates_)
-    u = rng.standard_normal(systems[0].model.ndof)
+    u = rng.standard_normal(backends[0].model.ndof)
     forces = []
-    for system in systems:
-        state = new_state(system.model)
-        state.u[:] = u
-        system.backend.force(system.model, state)
-        forces.append(state.f)
+    for backend in backends:
+        backend.set_state(u, np.zeros(mesh.nlayer), 0.0, 0.0)
+        forces.append(backend.read("f")[0])
     np.testing.assert_allclose(forces[0], forces[1], rtol=0, atol=1e-12 * np.abs(forces[1]).max())
-    model, work = systems[0].model, systems[0].backend.work
+    model, work = backends[0].model, backends[0].work
     # the plates alone, and a displacement that differs between the first and the last node of every
     # line (the wrap couples them): equal row by row to the CSR product
     ramp = np.full(model.ndof // 2, np.inf)  # x of each node (periodic images share the first node's DOFs)
@@ -70,8 +73,8 @@ def test_stencils_of_a_single_row_pair_are_the_element_stiffness():
 def test_parallel_product_has_the_serial_bits(threads):
     mesh = build_stack_mesh(MeshParams(N=54, plates=3))
     for name in ("structured", "assembled"):
-        serial = System(FemParams(N=54, plates=3, nchunk=20), mesh, make_backend(name)).backend.work
-        parallel = System(FemParams(N=54, plates=3, nchunk=20), mesh, make_backend(name, threads)).backend.work
+        serial = _backend(mesh, name).work
+        parallel = _backend(mesh, name, threads).work
         assert parallel.nblock > 1
         u = np.random.default_rng(1).standard_normal(mesh.dofs.max() + 1)
         f_serial, f_parallel = np.zeros(u.size), np.zeros(u.size)

@@ -4,6 +4,7 @@ import os
 
 import pytest
 
+from stickslip.fem.backends.cpu.forces import compute_force
 from stickslip.numba_options import CACHE, PACKAGE_DIR, subpackage_digest
 
 
@@ -26,7 +27,5 @@ def test_the_digest_follows_every_source_of_the_subpackage_and_no_other(tmp_path
 
 @pytest.mark.skipif(not CACHE, reason="STICKSLIP_NUMBA_CACHE=0: kernels are not cached")
 def test_a_kernel_of_the_package_is_cached_under_its_subpackage_digest():
-    from stickslip.fem.forces import compute_force
-
     stamp = compute_force._cache._impl.locator.get_source_stamp()
-    assert stamp[1] == subpackage_digest(PACKAGE_DIR / "fem" / "forces.py")
+    assert stamp[1] == subpackage_digest(PACKAGE_DIR / "fem" / "backends" / "cpu" / "forces.py")

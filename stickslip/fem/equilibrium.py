@@ -50,10 +50,6 @@ MAX_NEWTON = 200
 STALL = 10
 
 
-def _copy_state(state):
-    return type(state)(*(np.array(value, copy=True) for value in state))
-
-
 class WellEquilibrium:
     """The factorised constant stiffness of a model and the equilibrium solve within fixed wells.
 
@@ -124,31 +120,30 @@ class WellEquilibrium:
                 y -= c[layer] * self._Z[:, layer]
         return y
 
-    def relax(self, model, state, backend, tol):
-        """Equilibrium of the current wells from ``state`` (at rest), if it keeps every point in its well.
+    def relax(self, backend, tol):
+        """Move the backend's state to the equilibrium of its current wells, if it keeps every point in its well.
+
+        From the state at rest (``v = a = 0``) with every Gauss point held in its well, the
+        modified Newton iterations of the module docstring, one exchange with the backend each
+        (:meth:`.backends.base.Backend.correct`).
 
         Parameters
         ----------
-        model : Model
-        state : State
-            Start (its ``u``, drive targets and ``idx`` are used; not modified).
-        backend
-            Computes the forces (:mod:`.backends`).
+        backend : stickslip.fem.backends.base.Backend
+            Its model may be any with this one's linear parts (e.g. the elastic model of the linear response).
         tol : float
             The minimisation tolerance; the solve ends below ``tol^2``.
 
         Returns
         -------
-        State or None
-            The equilibrium (``v = a = 0``, forces, strain and stress evaluated at it,
-            wells unchanged), or None if the iterations did not converge or some Gauss
-            point of the equilibrium lies outside its current well.
+        bool
+            True if the state is now the equilibrium (``v = a = 0``, forces, strain and stress
+            evaluated at it, wells unchanged); False if the iterations did not converge or some Gauss
+            point of the equilibrium lies outside its current well: the state is then as before, bit for bit.
         """
-        trial = _copy_state(state)
-        trial.v[:] = 0.0
-        trial.a[:] = 0.0
-        backend.force(model, trial, update_wells=False)
-        best = backend.residual(model, trial)
+        before = backend.checkpoint()
+        backend.rest_in_wells()
+        best = backend.residual()
         bests = [best]  # the smallest residual after each iteration
         stalled = 0  # consecutive iterations that did not halve it
         stuck = False
@@ -158,13 +153,12 @@ class WellEquilibrium:
             stuck = stalled >= STALL and (best < tol or best > 0.5 * bests[-1 - STALL])
             if best <= tol * tol or stuck:
                 break
-            trial.u[self.free] -= self.solve(trial.f[self.free])
-            backend.force(model, trial, update_wells=False)
-            current = backend.residual(model, trial)
+            current = backend.correct(self.free, self.solve)
             stalled = 0 if current <= 0.5 * best else stalled + 1
             best = min(best, current)
             bests.append(best)
-        final = backend.residual(model, trial)
-        if not (final <= tol * tol or (stuck and final < tol)):
-            return None
-        return trial if backend.wells_hold(model, trial) else None
+        final = backend.residual()
+        if (final <= tol * tol or (stuck and final < tol)) and backend.wells_hold():
+            return True
+        backend.rollback(before)
+        return False

@@ -1,10 +1,10 @@
-"""The discretised model as arrays (``Model``, fixed) and its mutable state (``State``).
+"""The discretised model as arrays: ``Model``, physics and discretisation, fixed for a run.
 
-Both are named tuples of numpy arrays and scalars so that the numba kernels of
-:mod:`.forces`, :mod:`.dynamics` and :mod:`.minimise` take them whole. The model is physics
-and discretisation only (operators, masses, the interfaces' geometry, law and yield
-strains, the drive); how its products are computed (threads, plate kernels, scratch) is a
-backend's (:mod:`.backends`).
+A named tuple of numpy arrays and scalars, so that numba kernels take it whole: operators,
+masses, the interfaces' geometry, law and yield strains, the drive. How its products are
+computed (threads, plate kernels, scratch) and the state it acts on are a backend's
+(:mod:`.backends`); only the backend replaces its yield strains, when the window of held yield
+strains moves (:meth:`.backends.base.Backend.set_yield_strains`).
 Units are the FE model's own: length (block size ``h = pi``), stress (``G = 1``),
 mass density (``rho = 1``), time (``dt = 0.05``; shear-wave speed ``c_s = sqrt(G / 2 / rho)``).
 """
@@ -17,7 +17,7 @@ from .assembly import (assemble_csr, elastic_element_stiffness, element_dofs, la
                        lumped_diagonal)
 from .quad4 import element_coordinates, shape_gradients
 
-__all__ = ["Model", "State", "build_model", "new_state"]
+__all__ = ["Model", "build_model"]
 
 Model = namedtuple("Model", [
     "ndof",           # int: number of DOFs
@@ -41,18 +41,6 @@ Model = namedtuple("Model", [
     "free_lever",     # bool: targets follow the moment balance of a free lever
     "lever_ratio",    # float64 [nlayer]: h_l / H (free lever), layer height over drive height
 ])
-
-State = namedtuple("State", [
-    "u", "v", "a",    # float64 [ndof]: displacement [length], velocity, acceleration
-    "f",              # float64 [ndof]: internal force (material + drive, no damping) [force]
-    "idx",            # int64 [ni, 4]: current well per interface Gauss point
-    "eps", "sig",     # float64 [ni, 4, 3]: interface strain (xx, yy, xy) and stress
-    "target",         # float64 [nlayer]: drive target of ubar_x per layer [length]
-    "ubar",           # float64 [nlayer]: volume-averaged x-displacement per layer [length]
-    "lever",          # float64 [2]: (drive target x_target, lever position x_lever) at height H [length]
-    "t",              # float64 [1]: time [time]
-])
-
 
 def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height):
     """Assemble the model arrays of a layered mesh.
@@ -124,11 +112,3 @@ def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_
         drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),
         lever_ratio=heights / float(lever_height))
 
-
-def new_state(model):
-    """A state at rest: zero displacement, velocity, targets and time (forces not yet evaluated)."""
-    ni = model.iface_dofs.shape[0]
-    nlayer = model.layer_volume.size
-    return State(u=np.zeros(model.ndof), v=np.zeros(model.ndof), a=np.zeros(model.ndof), f=np.zeros(model.ndof),
-                 idx=np.zeros((ni, 4), dtype=np.int64), eps=np.zeros((ni, 4, 3)), sig=np.zeros((ni, 4, 3)),
-                 target=np.zeros(nlayer), ubar=np.zeros(nlayer), lever=np.zeros(2), t=np.zeros(1))

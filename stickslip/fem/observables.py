@@ -72,16 +72,18 @@ def observable_columns(nlayer, n_interfaces, free_lever):
 
 
 class Observer:
-    """Computes the observables of a :class:`.system.System` state.
+    """Computes the observables of the state of a simulation's stack (read through its backend).
 
     Parameters
     ----------
-    system : System
+    simulation : stickslip.fem.simulation.Simulation
     """
 
-    def __init__(self, system):
-        mesh = system.mesh
-        self.system = system
+    def __init__(self, simulation):
+        mesh = simulation.mesh
+        self.stack = simulation.stack
+        self.params = simulation.params
+        self.sig0 = simulation.constants["sig0"]
         xe = element_coordinates(mesh.coor, mesh.conn)
         self.dNdx, self.dV = shape_gradients(xe)
         self.edofs = element_dofs(mesh.conn, mesh.dofs)
@@ -91,14 +93,13 @@ class Observer:
         self.N = int(mesh.N)
         self.volume = np.bincount(self.elem_layer, weights=self.dV.sum(axis=1), minlength=self.nlayer)
         self.plastic = np.asarray(mesh.layer_is_plastic, dtype=bool)
-        heights = system.heights
-        p = system.params
-        self.gamma0 = 90.0 - math.degrees(math.atan2(heights[1], p.eps0 * float(mesh.h)))
+        heights = np.asarray(mesh.layer_mid_height, dtype=np.float64)
+        self.gamma0 = 90.0 - math.degrees(math.atan2(heights[1], self.params.eps0 * float(mesh.h)))
         self.top_height = heights[-1]
 
     def well_index(self):
         """Global well index of Gauss point 0 of every interface block, int64 [n_interfaces, N]."""
-        return self.system.well_index()[:, 0].reshape(self.n_interfaces, self.N)
+        return self.stack.well_index()[:, 0].reshape(self.n_interfaces, self.N)
 
     def observe(self, previous_index):
         """Observables of the current state.
@@ -113,35 +114,35 @@ class Observer:
         dict[str, float]
             Keys :func:`observable_columns`.
         """
-        s = self.system.state
-        p = self.system.params
-        model = self.system.model
-        eps0, sig0 = p.eps0, self.system.constants["sig0"]
-        eps_sum = layer_strain_sums(s.u, self.edofs, self.dNdx, self.dV, self.elem_layer, self.nlayer)
+        u, sig, target, ubar, lever, t = self.stack.backend.read("u", "sig", "target", "ubar", "lever", "t")
+        p = self.params
+        model = self.stack.model
+        eps0, sig0 = p.eps0, self.sig0
+        eps_sum = layer_strain_sums(u, self.edofs, self.dNdx, self.dV, self.elem_layer, self.nlayer)
         sig_sum = np.empty_like(eps_sum)
         for layer in range(self.nlayer):
             sig_sum[layer] = elastic_stress(*eps_sum[layer], p.K, p.G)
-        iface_sig = (s.sig * model.iface_dV[:, :, None]).reshape(self.n_interfaces, -1, 3).sum(axis=1)
+        iface_sig = (sig * model.iface_dV[:, :, None]).reshape(self.n_interfaces, -1, 3).sum(axis=1)
         sig_sum[self.plastic] = iface_sig
-        row = {"t": float(s.t[0])}
-        target_top = s.target[-1]
+        row = {"t": float(t[0])}
+        target_top = target[-1]
         row["gamma"] = (90.0 - math.degrees(math.atan2(self.top_height, target_top))) / self.gamma0
         total_eps = eps_sum.sum(axis=0) / self.volume.sum()
         total_sig = sig_sum.sum(axis=0) / self.volume.sum()
         row["epsd"] = equivalent_strain(*total_eps) / eps0
         row["sigd"] = equivalent_stress(*total_sig) / sig0
         if model.free_lever:
-            row["lever_target"] = float(s.lever[0])
-            row["lever_position"] = float(s.lever[1])
+            row["lever_target"] = float(lever[0])
+            row["lever_position"] = float(lever[1])
         for layer in range(self.nlayer):
             row[f"epsd_{layer}"] = equivalent_strain(*(eps_sum[layer] / self.volume[layer])) / eps0
         for layer in range(self.nlayer):
             row[f"sigd_{layer}"] = equivalent_stress(*(sig_sum[layer] / self.volume[layer])) / sig0
         for layer in range(self.nlayer):
-            row[f"ubar_{layer}"] = float(s.ubar[layer])
+            row[f"ubar_{layer}"] = float(ubar[layer])
         for layer in range(self.nlayer):
-            active = self.system.drive_active[layer]
-            row[f"fxdrive_{layer}"] = float(s.target[layer] - s.ubar[layer]) if active else 0.0
+            active = model.drive_active[layer]
+            row[f"fxdrive_{layer}"] = float(target[layer] - ubar[layer]) if active else 0.0
         index = self.well_index()
         hops = index - previous_index
         for a in range(self.n_interfaces):

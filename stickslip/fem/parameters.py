@@ -10,7 +10,7 @@ import dataclasses
 from ..formats import fem_run
 from ..params import ParameterError, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
-from .laws import INTERFACE_LAWS
+from .laws import INTERFACE_LAWS, make_law
 
 __all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "stored_params"]
 
@@ -79,12 +79,12 @@ class FemParams:
                                    "block comes within `margin` wells of the end of its first `nchunk` wells (with "
                                    "'stop' the increment is aborted there; with 'extend' it is completed, not "
                                    "stored)", minimum=0)
-    interface_law: str = param("cusp", "potential of the interface blocks in a well: 'cusp' (parabolas joined by "
-                                       "cusps, the paper's) or 'smooth' (wells joined smoothly; docs/fem.md)",
+    interface_law: str = param("cusp", "potential of the interface blocks in a well (docs/fem.md, 'Interface laws')",
                                choices=INTERFACE_LAWS, extension=True)
-    backend: str = param(DEFAULT_BACKEND, "how the numbers are computed: 'structured' (stencil kernels, default) "
-                                          "or 'assembled' (the CSR reference; other round-off, so its own run id)",
-                         choices=tuple(BACKENDS), extension=True)
+    law_params: tuple[float, ...] = param((), "the interface law's parameters after K and G, in the order the law "
+                                              "declares them (none for the built-in laws)", extension=True)
+    backend: str = param(DEFAULT_BACKEND, "how the numbers are computed; a backend of other round-off than the "
+                                          "default makes its own run id", choices=BACKENDS, extension=True)
     temperature: float = param(0.0, "thermal activation of the interface blocks: 0 is the paper's athermal event-driven "
                                     "protocol; > 0 the kinetic Monte Carlo protocol with a finite drive rate "
                                     "(docs/fem.md, 'Finite temperature'); energy in units of the barrier of a block a "
@@ -106,6 +106,7 @@ class FemParams:
 
     def check(self):
         """Check conditions across fields."""
+        self._check_law()
         if self.temperature > 0.0 and self.yield_strains != "extend":
             raise ParameterError("parameter 'yield_strains': a thermal run (temperature > 0) needs 'extend'")
         if self.temperature == 0.0:
@@ -117,6 +118,20 @@ class FemParams:
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
+
+
+    def _check_law(self):
+        law = INTERFACE_LAWS[self.interface_law]
+        try:
+            make_law(law.name, self.K, self.G, self.law_params)
+        except ValueError as error:
+            raise ParameterError(f"parameter 'law_params': {error}") from None
+        if self.relaxation == "exact" and not law.exact_relaxation:
+            raise ParameterError(f"parameter 'relaxation': law '{law.name}' has a curvature that the elastic stiffness "
+                                 "does not bound, so 'exact' cannot converge; expected 'dynamic'")
+        if self.temperature > 0.0 and not law.thermal:
+            raise ParameterError(f"parameter 'temperature': law '{law.name}' has no exact barriers for thermal "
+                                 "activation; expected 0")
 
 
 def stored_params(file):

@@ -3,7 +3,8 @@
 The replay is the ``fem`` solver's capability (:func:`stickslip.registry.register`,
 ``replay=``): an analysis asks the solver that wrote a file to replay its events. The
 model is built once per run file; each replay restores the stored state before the kick
-and runs the same kick and minimisation as the run (:meth:`.system.System.kick_and_minimise`).
+and runs the same kick and relaxation as the run
+(:meth:`.protocol.AthermalProtocol.perturb_and_relax` with :class:`.loading.KickAlongResponse`).
 For a thermal run it also holds a stored state at a load and reloads it
 (:meth:`EventReplay.hold`, :mod:`.thermal.holds`).
 """
@@ -14,8 +15,10 @@ import pandas as pd
 from ..formats.fem_run import RunFile
 from ..h5io import FileFormatError, open_file
 from .backends import make_backend
+from .loading import KickAlongResponse
 from .parameters import stored_params
-from .system import System
+from .simulation import Simulation
+from .thermal import hold_trial
 
 __all__ = ["EventReplay"]
 
@@ -43,12 +46,11 @@ class EventReplay:
             run = RunFile(file)
             self.params, self.nstored = stored_params(file), run.nstored
             table = run.increments()
-            response = run.linear_response()
             self.N = run.mesh.N
-            self.system = System(self.params, run.mesh, backend or make_backend(self.params.backend))
+            self.simulation = Simulation(self.params, run.mesh, backend or make_backend(self.params.backend),
+                                         response=run.linear_response())
         self._kick = table["kick"].to_numpy(dtype=bool)
         self._yield_element = table["yield_element"].to_numpy(dtype=bool)
-        self.system.set_linear_response(*response)
 
     def _state(self, increment):
         with open_file(self.path) as file:
@@ -62,11 +64,9 @@ class EventReplay:
         FileFormatError
             If the run is athermal (``temperature = 0``) or the increment is not stored.
         """
-        from .thermal.holds import hold_trial
-
         if self.params.temperature <= 0.0:
             raise FileFormatError(f"{self.path}: an athermal run (temperature = 0) has no hold trials")
-        return hold_trial(self.system, self._state(increment), hold_time, below, replica)
+        return hold_trial(self.simulation, self._state(increment), hold_time, below, replica)
 
     def failures(self, increment):
         """Redo one kick increment and record every well hop of the interface blocks.
@@ -94,10 +94,12 @@ class EventReplay:
         if not 1 <= increment < self.nstored or not self._kick[increment]:
             raise FileFormatError(f"{self.path}: increment {increment} is not a stored kick increment")
         before, after = self._state(increment - 1), self._state(increment)
-        self.system.restore(*before)
-        niter, events = self.system.kick_and_minimise(bool(self._yield_element[increment]), self.params.margin,
-                                                      record=True)
-        if niter == 0 or not np.array_equal(self.system.state.u, after[0]) or self.system.state.t[0] != after[3]:
+        s = self.simulation
+        s.stack.restore(*before)
+        kick = KickAlongResponse(s.loading, bool(self._yield_element[increment]))
+        niter, events = s.protocol.perturb_and_relax(kick, self.params.margin, record=True)
+        u, t = s.stack.backend.read("u", "t")
+        if niter == 0 or not np.array_equal(u, after[0]) or t[0] != after[3]:
             raise AssertionError(f"{self.path}: replaying increment {increment} did not reproduce the stored state")
         element = events[:, 0].astype(np.int64)
         return pd.DataFrame({"a": element // self.N + 1, "block": element % self.N, "t": events[:, 1] - before[3],

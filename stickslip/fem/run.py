@@ -34,9 +34,8 @@ from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .observables import Observer, observable_columns
 from .parameters import stored_params
-from .protocol import make_protocol
+from .simulation import Simulation
 from .stiffness import driving_regime, stiffness_ratio
-from .system import System
 
 __all__ = ["run_simulation"]
 
@@ -45,8 +44,8 @@ __all__ = ["run_simulation"]
 FREE_SPACE_MARGIN = 4 * 2**20
 
 
-def _row(observer, increment, kick, previous_index, columns):
-    row = {"increment": increment, "kick": kick, **columns}
+def _row(observer, increment, event, previous_index, columns):
+    row = {"increment": increment, "kick": event, **columns}
     row.update(observer.observe(previous_index))
     return row
 
@@ -76,31 +75,30 @@ class _Progress:
         self.bar.update(1)
 
 
-def _header(system, observer, protocol, producer):
+def _header(simulation, observer, producer):
     """Root attributes of the run file: the fields of :data:`stickslip.formats.fem_run.HEADER`, then ``fem``'s own
     (the protocol's last)."""
-    p, c = system.params, system.constants
+    p, c = simulation.params, simulation.constants
     phi = stiffness_ratio(p.k_drive, p.N, p.G)
     return {"solver": producer[0], "solver_version": producer[1], "params": params_to_dict(p),
             "N": p.N, "plates": p.plates, "n_interfaces": p.plates - 1, "k_drive": p.k_drive, "drive": p.drive,
             "seed": p.seed, "nchunk": p.nchunk, "eps0": p.eps0, "sig0": c["sig0"], "gamma0": observer.gamma0,
             "c_s": c["c_s"], "h": c["h"], "dt": c["dt"], "alpha": c["alpha"], "H": c["H"],
-            "phi": phi, "regime": driving_regime(phi), **protocol.header}
+            "phi": phi, "regime": driving_regime(phi), **simulation.protocol.header}
 
 
 def _create(path, params, mesh, backend, producer):
-    system = System(params, mesh, backend)
-    system.compute_linear_response()
-    observer = Observer(system)
-    protocol = make_protocol(system)
-    columns = observable_columns(observer.nlayer, observer.n_interfaces, system.model.free_lever)
-    response = (system.delta_u, system.delta_eps, system.delta_target, system.delta_lever)
+    simulation = Simulation(params, mesh, backend)
+    observer = Observer(simulation)
+    protocol = simulation.protocol
+    columns = observable_columns(observer.nlayer, observer.n_interfaces, simulation.stack.model.free_lever)
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
-            create_file(file, _header(system, observer, protocol, producer), system.mesh, response,
+            create_file(file, _header(simulation, observer, producer), mesh, simulation.loading.response,
                         columns + list(protocol.columns), protocol.columns)
-            append_increment(file, system.snapshot(), _row(observer, 0, True, observer.well_index(),
-                                                           {"yield_element": False, **protocol.initial_row()}))
+            append_increment(file, simulation.stack.stored(),
+                             _row(observer, 0, True, observer.well_index(),
+                                  {"yield_element": False, **protocol.initial_row()}))
 
 
 def _stored(output, params):
@@ -185,35 +183,35 @@ def _increments(params, output, backend):
     with open_file(output, "r+") as file:
         file.swmr_mode = True
         run = RunFile(file)
-        system = System(params, run.mesh, backend)
-        system.set_linear_response(*run.linear_response())
+        simulation = Simulation(params, run.mesh, backend, response=run.linear_response(),
+                                table=read_table(file, "increments", rows=run.nstored))
+        stack, protocol = simulation.stack, simulation.protocol
         increment = run.nstored - 1
-        system.restore(*run.state(increment))
-        observer = Observer(system)
-        protocol = make_protocol(system, read_table(file, "increments", rows=run.nstored))
-        kick = bool(file["increments/kick"][increment])
+        stack.restore(*run.state(increment))
+        observer = Observer(simulation)
+        event = bool(file["increments/kick"][increment])
         previous_index = observer.well_index()
         new = 0
         reason = ""
         report = _Progress(file, params, increment)
         needed = 2 * run.increment_bytes() + FREE_SPACE_MARGIN
-        last_well = params.nchunk + 1 - params.margin if system.extend and not params.max_increments else None
+        last_well = params.nchunk + 1 - params.margin if stack.extend and not params.max_increments else None
         while not reason:
             if params.max_increments and increment >= params.max_increments:
                 reason = "max_increments"
                 break
             increment += 1
-            kick = not kick
-            columns = protocol.step(kick, params.margin, increment)
+            event = not event
+            columns = protocol.step(event, params.margin, increment)
             if columns is None:
                 reason = "margin"
                 break
-            if last_well is not None and system.well_index().max() >= last_well:
+            if last_well is not None and stack.well_index().max() >= last_well:
                 reason = "margin"
                 break
             check_free_space(output, needed, FREE_SPACE_MARGIN)
-            row = _row(observer, increment, kick, previous_index, columns)
-            append_increment(file, system.snapshot(), row)
+            row = _row(observer, increment, event, previous_index, columns)
+            append_increment(file, stack.stored(), row)
             protocol.stored(row)
             previous_index = observer.well_index()
             new += 1

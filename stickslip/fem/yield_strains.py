@@ -88,7 +88,7 @@ def _fill(epsy, start, state, inc, last, two_eps0, eps_offset, inv_k):
 
 
 @njit
-def _slide(epsy, idx, offset, shift, state, inc, last, two_eps0, eps_offset, inv_k):
+def _slide(epsy, offset, shift, state, inc, last, two_eps0, eps_offset, inv_k):
     """Move the window of every block ``e`` forward by ``shift[e]`` values (drawing as many new ones)."""
     ny = epsy.shape[1]
     start = np.full(epsy.shape[0], ny, dtype=np.int64)
@@ -98,8 +98,6 @@ def _slide(epsy, idx, offset, shift, state, inc, last, two_eps0, eps_offset, inv
             continue
         for j in range(ny - s):
             epsy[e, j] = epsy[e, j + s]
-        for q in range(idx.shape[1]):
-            idx[e, q] -= s
         offset[e] += s
         start[e] = ny - s
     _fill(epsy, start, state, inc, last, two_eps0, eps_offset, inv_k)
@@ -202,17 +200,15 @@ class HeldYieldStrains:
         _fill(self.epsy, np.ones(nelem, dtype=np.int64), self.state, self.inc, self.last, *self._constants)
         self.epsy[:, 0] = -self.epsy[:, 1]
 
-    def slide(self, idx, shift):
-        """Move windows forward.
+    def slide(self, shift):
+        """Move windows forward (the held well indices of a block fall by its shift: the caller renumbers them).
 
         Parameters
         ----------
-        idx : numpy.ndarray
-            int64 [nelem, nq] held well indices; decreased by ``shift`` in place.
         shift : numpy.ndarray
             int64 [nelem] values to drop at the front of each window (0: unchanged).
         """
-        _slide(self.epsy, idx, self.offset, np.asarray(shift, dtype=np.int64), self.state, self.inc, self.last,
+        _slide(self.epsy, self.offset, np.asarray(shift, dtype=np.int64), self.state, self.inc, self.last,
                *self._constants)
 
     def widen(self, extra):

@@ -1,25 +1,19 @@
 """Execution backends of the fem model: how the numbers are computed, not what they are.
 
-A backend is chosen once per run (:func:`make_backend`) and passed to :class:`..system.System`,
-which prepares it for its model (``prepare(model, mesh)`` returns the backend with its workspace); the physics
-(:class:`..model.Model` and its law) is passed to every call. Its interface:
-
-``prepare(model, mesh)``, ``force(model, state, update_wells=True)``, ``time_step(model, state)``,
-``minimise(model, state, tol, niter_tol, max_iter, margin, record, quiet=0)`` (the whole
-minimisation loop in the backend), ``residual(model, state)``, ``wells_hold(model, state)``,
-and the attributes ``name``, ``summary``, ``threads``.
-
-Built in: ``structured`` (default, :mod:`.structured`) and ``assembled`` (the reference,
-:mod:`.assembled`), numba CPU backends (:mod:`.cpu`). A backend whose results are bit-identical
-to the default's would be an execution option like ``threads``; both alternatives here change
-the round-off, so the choice is the ``backend`` parameter of ``fem`` (recorded in the run file
-and its id). docs/developing.md, "A new backend".
+A backend is chosen once per run (:func:`make_backend`) and prepared for its model (it then owns
+the state; :mod:`.base` is the seam every backend implements). Built in: ``structured`` (default)
+and ``assembled`` (the reference), numba CPU backends (:mod:`.cpu`). A backend whose results are
+bit-identical to the default's would be an execution option like ``threads``; both alternatives
+here change the round-off, so the choice is the ``backend`` parameter of ``fem`` (recorded in the
+run file and its id). A new backend: one module and :func:`register_backend` (docs/developing.md,
+"A new backend").
 """
 
-from .assembled import AssembledBackend
-from .structured import StructuredBackend
+from .base import CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend
+from .cpu import AssembledBackend, StructuredBackend
 
-__all__ = ["BACKENDS", "DEFAULT_BACKEND", "make_backend", "register_backend"]
+__all__ = ["BACKENDS", "DEFAULT_BACKEND", "Backend", "make_backend", "register_backend", "FIELDS", "CONVERGED",
+           "MARGIN", "QUIET", "MAX_ITER_REACHED"]
 
 #: Backend classes by name.
 BACKENDS = {}
@@ -41,13 +35,16 @@ register_backend(AssembledBackend)
 
 
 def make_backend(name=DEFAULT_BACKEND, threads=1):
-    """The backend ``name`` with ``threads`` threads (:class:`..system.System` prepares it for its model).
+    """The backend ``name`` with ``threads`` threads (to be prepared for a model, :meth:`.base.Backend.prepare`).
 
     Raises
     ------
     ValueError
-        If no backend of that name is registered.
+        If no backend of that name is registered, or it cannot run on this machine (the reason).
     """
     if name not in BACKENDS:
         raise ValueError(f"backend {name!r}: expected one of {', '.join(sorted(BACKENDS))}")
+    reason = BACKENDS[name].unavailable()
+    if reason:
+        raise ValueError(f"backend {name!r} cannot run here: {reason}")
     return BACKENDS[name](threads=threads)

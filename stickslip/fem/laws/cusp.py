@@ -42,6 +42,10 @@ class Cusp(namedtuple("Cusp", ("K", "G"))):
 
     __slots__ = ()
     name = "cusp"
+    summary = "parabolas joined by cusps (the paper's)"
+    yields = True
+    exact_relaxation = True
+    thermal = True
     deviatoric_factor = staticmethod(_deviatoric_factor)
     well_energy = staticmethod(_well_energy)
     forward_barrier = staticmethod(_forward_barrier)

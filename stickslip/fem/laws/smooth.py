@@ -57,6 +57,10 @@ class Smooth(namedtuple("Smooth", ("K", "G"))):
 
     __slots__ = ()
     name = "smooth"
+    summary = "wells joined smoothly (GMatElastoPlasticQPot's Smooth)"
+    yields = True
+    exact_relaxation = True
+    thermal = True
     deviatoric_factor = staticmethod(_deviatoric_factor)
     well_energy = staticmethod(_well_energy)
     forward_barrier = staticmethod(_forward_barrier)

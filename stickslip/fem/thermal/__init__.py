@@ -4,15 +4,16 @@ The protocol of a ``temperature > 0`` run (:class:`.protocol.ThermalProtocol`): 
 Carlo on top of the event-driven protocol. Every block hops over the barrier of its well
 (:mod:`.barriers`, from the law) at an Arrhenius rate; the next hop is drawn exactly from the
 time-dependent total rate while the drive advances (:mod:`.sampler`); a hop carries the block over
-its barrier and minimises (:mod:`.hop`); the athermal threshold, if it comes first, is the usual
+its barrier (:mod:`.hop`) and the stack relaxes; the athermal threshold, if it comes first, is the usual
 kick. docs/fem.md, "Finite temperature".
 """
 
 from .barriers import BACKWARD, FORWARD, barrier_bounds, block_barrier, block_barriers
-from .hop import hop, hop_step, shear_modes
+from .hop import ShearHop, hop_step, shear_modes
+from .holds import hold_trial
 from .protocol import COLUMNS, HoldSchedule, ThermalProtocol, drive_scale, energy_unit
 from .sampler import HOP, NONE, THRESHOLD, sample_event
 
-__all__ = ["ThermalProtocol", "HoldSchedule", "COLUMNS", "drive_scale", "energy_unit", "FORWARD", "BACKWARD", "block_barrier",
-           "block_barriers", "barrier_bounds", "sample_event", "NONE", "HOP", "THRESHOLD", "hop", "hop_step",
-           "shear_modes"]
+__all__ = ["ThermalProtocol", "HoldSchedule", "COLUMNS", "drive_scale", "energy_unit", "FORWARD", "BACKWARD",
+           "block_barrier", "block_barriers", "barrier_bounds", "sample_event", "NONE", "HOP", "THRESHOLD", "ShearHop",
+           "hop_step", "shear_modes", "hold_trial"]

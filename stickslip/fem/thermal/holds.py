@@ -27,10 +27,11 @@ MAX_EVENTS = 2000
 REPLICAS = 2**40
 
 
-def _barriers(system, unit):
-    model, state = system.model, system.state
+def _barriers(simulation, unit):
+    model = simulation.stack.model
+    idx, eps = simulation.stack.backend.read("idx", "eps")
     out = np.empty((model.epsy.shape[0], 2))
-    block_barriers(model.law, model.epsy, state.idx, state.eps, system.delta_eps, model.iface_dV, 0.0, out)
+    block_barriers(model.law, model.epsy, idx, eps, simulation.loading.response.delta_eps, model.iface_dV, 0.0, out)
     return out[:, FORWARD] / unit
 
 
@@ -39,13 +40,13 @@ def _slips(observer):
     return observer.well_index().sum(axis=1).astype(np.float64)
 
 
-def hold_trial(system, state, hold_time, below, replica):
+def hold_trial(simulation, state, hold_time, below, replica):
     """One hold trial from a stored state (module docstring).
 
     Parameters
     ----------
-    system : stickslip.fem.system.System
-        Of a thermal run, with its linear response set.
+    simulation : stickslip.fem.simulation.Simulation
+        Of a thermal run.
     state : tuple
         ``(u, target, lever_target, t)`` of a stored increment (:meth:`stickslip.formats.fem_run.RunFile.state`).
     hold_time : float
@@ -67,20 +68,21 @@ def hold_trial(system, state, hold_time, below, replica):
         ``barriers_start``, ``barriers_end`` (float64 [ni]: forward barrier of every block /
         temperature, at the start and the end of the hold).
     """
-    p = system.params
-    system.restore(*state)
-    ds_c = system.step_size(False)
-    system.load(max(ds_c - below / drive_scale(system), 0.0))
-    observer = Observer(system)
-    protocol = ThermalProtocol(system, stream=STREAM + REPLICAS * (replica + 1))
+    s, p = simulation, simulation.params
+    s.stack.restore(*state)
+    ds_c = s.loading.step_size(False)
+    s.loading.load(max(ds_c - below / drive_scale(s.loading.response, p.eps0, s.mesh), 0.0))
+    observer = Observer(s)
+    protocol = ThermalProtocol(s.stack, s.loading, s.relaxation, p, s.mesh, s.constants,
+                               stream=STREAM + REPLICAS * (replica + 1))
     unit = protocol.energy_unit * p.temperature
-    t0 = float(system.state.t[0])
+    t0 = s.stack.time
     protocol.schedule.hold_now(t0, hold_time)
     interfaces = range(1, p.plates)
     names = [f"sigd_{2 * a - 1}" for a in interfaces]
     start = observer.observe(observer.well_index())
     r0 = _slips(observer)
-    barriers_start = barriers_end = _barriers(system, unit)
+    barriers_start = barriers_end = _barriers(s, unit)
     previous = observer.well_index()
     creep = []
     result = {"t0": t0, "peak": np.nan, "interface": 0, "mu_start": np.nan, "failed_in_hold": False,
@@ -88,7 +90,7 @@ def hold_trial(system, state, hold_time, below, replica):
     for k in range(1, MAX_EVENTS + 1):
         protocol.step(False, p.margin, 2 * k - 1)
         load = observer.observe(previous)
-        t = float(system.state.t[0]) - t0
+        t = s.stack.time - t0
         previous = observer.well_index()
         protocol.step(True, p.margin, 2 * k)
         event = observer.observe(previous)
@@ -96,7 +98,7 @@ def hold_trial(system, state, hold_time, below, replica):
         if t < hold_time:
             result["hold_hops"] += 1
             creep.append([t, *(_slips(observer) - r0)])
-            barriers_end = _barriers(system, unit)
+            barriers_end = _barriers(s, unit)
         slipping = [a for a in interfaces if event[f"A_a{a}"] == p.N]
         if slipping:
             a = slipping[0]

@@ -1,14 +1,14 @@
-"""A thermally activated hop: one block carried over its barrier, then the usual minimisation.
+"""A thermally activated hop: one block carried over its barrier, a perturbation of the stack.
 
 The barrier of a block (:mod:`.barriers`) is the energy to shear it over the edge of its well with
-its surroundings held fixed. The hop does that: the block's shear mode (its upper nodes moved by
-``+s/2`` in x, its lower nodes by ``-s/2``; a uniform simple shear ``eps_xy = s / (2 h)`` of the
-block) is applied with the smallest ``|s|`` that carries every one of its four Gauss points a
-strain ``deps / 2`` past the edge (the athermal kick's overshoot), and the state is minimised
-(:meth:`..system.System.kick_and_minimise`: the relaxation of the run, an avalanche may follow).
-If the minimisation brings every well index back (the block fell back into its well: the true
-barrier of the move is higher than the constant-load one), the state before the hop is restored
-and the hop counts as failed.
+its surroundings held fixed. The hop does that (:class:`ShearHop`): the block's shear mode (its
+upper nodes moved by ``+s/2`` in x, its lower nodes by ``-s/2``; a uniform simple shear
+``eps_xy = s / (2 h)`` of the block) is applied with the smallest ``|s|`` that carries every one
+of its four Gauss points a strain ``deps / 2`` past the edge (the athermal kick's overshoot). The
+thermal protocol then relaxes the stack as after a kick
+(:meth:`..protocol.AthermalProtocol.perturb_and_relax`: the relaxation of the run, an avalanche may
+follow), and restores the state before the hop if every well index came back (the block fell back
+into its well: the true barrier of the move is higher than the constant-load one).
 """
 
 import math
@@ -16,10 +16,11 @@ import math
 import numpy as np
 
 from ...numba_options import njit
+from ..errors import SolverError
 from ..quad4 import element_strain
 from .barriers import FORWARD
 
-__all__ = ["shear_modes", "hop_step", "hop"]
+__all__ = ["shear_modes", "hop_step", "ShearHop"]
 
 
 def shear_modes(mesh):
@@ -99,59 +100,49 @@ def hop_step(dNdx, mode, eps, epsy, idx, direction, overshoot):
     return step
 
 
-def hop(system, modes, block, direction, margin):
-    """Carry ``block`` over its edge in ``direction`` and minimise; restore the state if it falls back.
+class ShearHop:
+    """The hop of one block over an edge of its well, by its shear mode: a perturbation of the stack.
 
     Parameters
     ----------
-    system : stickslip.fem.system.System
-        At rest; its wells must be held with ``yield_strains = extend``.
+    stack : stickslip.fem.stack.Stack
+        At rest.
     modes : numpy.ndarray
         [ni, 8] :func:`shear_modes`.
     block : int
         Interface element.
     direction : int
         :data:`.barriers.FORWARD` or backward.
-    margin : int
-        See :meth:`..system.System.minimise`.
-
-    Returns
-    -------
-    bool
-        True if some well index changed (the hop happened); False if the block fell back or the mode
-        cannot carry it over (the state is then as before).
-
-    Raises
-    ------
-    SolverError
-        If the kick did not move every Gauss point of the block to the next well (a bug, not physics).
+    overshoot : float
+        Strain beyond the edge that every Gauss point of the block reaches (the kick's ``deps / 2``).
     """
-    from ..system import SolverError
 
-    model, state = system.model, system.state
-    dofs = model.iface_dofs[block]
-    overshoot = 0.5 * system.constants["deps"]
-    if math.isnan(hop_step(model.iface_dNdx[block], modes[block], state.eps[block], model.epsy[block],
-                           state.idx[block], direction, overshoot)):
-        return False
-    before = system.snapshot()
-    index = system.well_index()
-    sign = 1 if direction == FORWARD else -1
+    def __init__(self, stack, modes, block, direction, overshoot):
+        self.stack = stack
+        self.mode = modes[block]
+        self.block = block
+        self.direction = direction
+        self.overshoot = overshoot
 
-    def kick():
-        step = hop_step(system.model.iface_dNdx[block], modes[block], state.eps[block], system.model.epsy[block],
-                        state.idx[block], direction, overshoot)
-        start = system.well_index()[block]
-        state.u[dofs] += step * modes[block]
-        system.refresh()
-        if np.any(np.sign(system.well_index()[block] - start) != sign):
-            raise SolverError(f"hop of block {block}: the kick of {step:.6e} did not carry all its Gauss points "
+    def step(self):
+        """Amplitude ``s`` of the shear mode from the state now [length] (:func:`hop_step`; NaN: impossible)."""
+        model, b = self.stack.model, self.block
+        eps, idx = self.stack.backend.read("eps", "idx")
+        return hop_step(model.iface_dNdx[b], self.mode, eps[b], model.epsy[b], idx[b], self.direction, self.overshoot)
+
+    def apply(self):
+        """Shear the block over its edge.
+
+        Raises
+        ------
+        SolverError
+            If the shear did not move every Gauss point of the block to the next well (a bug, not physics).
+        """
+        stack, b = self.stack, self.block
+        step = self.step()
+        start = stack.well_index()[b]
+        stack.backend.add_u(stack.model.iface_dofs[b], step * self.mode)
+        sign = 1 if self.direction == FORWARD else -1
+        if np.any(np.sign(stack.well_index()[b] - start) != sign):
+            raise SolverError(f"hop of block {b}: the kick of {step:.6e} did not carry all its Gauss points "
                               "over the edge")
-
-    niter, _ = system.kick_and_minimise(False, margin, kick=kick)
-    if niter and system.extend:
-        system.hold_wells_ahead()
-    if np.array_equal(system.well_index(), index):
-        system.restore(*before)
-        return False
-    return True

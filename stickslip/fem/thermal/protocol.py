@@ -7,9 +7,9 @@ Increments alternate as in the athermal protocol, a load then an event:
   every Gauss point within its well, and the next event is drawn exactly
   (:func:`.sampler.sample_event`): a thermally activated hop of a block, or the athermal threshold
   if no hop comes first. The stored load increment is the state loaded to the time of that event
-  (for the threshold: the athermal load step to the brink, :meth:`..system.System.event_step`).
-- **event** (even increments): the hop (:func:`.hop.hop`) or the athermal kick
-  (:meth:`..system.System.kick`), with the minimisation of the run.
+  (for the threshold: the athermal load step to the brink, :meth:`..loading.Loading.step`).
+- **event** (even increments): the hop (:meth:`ThermalProtocol.hop`) or the athermal kick
+  (:meth:`..protocol.AthermalProtocol.kick`), with the relaxation of the run.
 
 A hop whose block falls back into its well restores the state, counts as failed (column
 ``failed_hops`` of the next load increment) and leaves that block and direction out of the
@@ -38,9 +38,11 @@ import math
 
 import numpy as np
 
+from ..errors import SolverError
+from ..protocol import AthermalProtocol
 from ..random import pcg32_seed
 from .barriers import BACKWARD, FORWARD
-from .hop import hop, shear_modes
+from .hop import ShearHop, shear_modes
 from .sampler import HOP, NONE, sample_event
 
 __all__ = ["ThermalProtocol", "HoldSchedule", "COLUMNS", "drive_scale", "energy_unit", "STREAM"]
@@ -57,9 +59,16 @@ def energy_unit(params, h):
     return params.G * params.eps0 ** 2 * h ** 2
 
 
-def drive_scale(system):
-    """Imposed shear gamma, in eps0, per unit drive offset of the linear response (:meth:`..system.System.load`)."""
-    return float(system.delta_target[-1] / (2.0 * system.params.eps0 * system.heights[-1]))
+def drive_scale(response, eps0, mesh):
+    """Imposed shear gamma, in eps0, per unit drive offset of the linear response (:meth:`..loading.Loading.load`).
+
+    Parameters
+    ----------
+    response : stickslip.fem.linear_response.LinearResponse
+    eps0 : float
+    mesh : stickslip.mesh.LayeredMesh
+    """
+    return float(response.delta_target[-1] / (2.0 * eps0 * mesh.layer_mid_height[-1]))
 
 
 class HoldSchedule:
@@ -118,13 +127,18 @@ def _slips(table, N):
     return np.asarray(table["t"], dtype=np.float64)[kick & full]
 
 
-class ThermalProtocol:
-    """Thermally activated hops with a finite drive rate (module docstring).
+class ThermalProtocol(AthermalProtocol):
+    """Thermally activated hops with a finite drive rate (module docstring): the athermal protocol with its own steps.
 
     Parameters
     ----------
-    system : System
-        With ``params.temperature > 0``, at the last stored increment.
+    stack, loading, relaxation
+        As :class:`..protocol.AthermalProtocol` (the stack at the last stored increment).
+    params : FemParams
+        With ``temperature > 0``.
+    mesh : stickslip.mesh.LayeredMesh
+    constants : dict
+        :func:`..constants.derived_constants`.
     table : Mapping[str, numpy.ndarray], optional
         The stored increment table's columns (a resumed run), None for a new run.
     stream : int, optional
@@ -134,14 +148,15 @@ class ThermalProtocol:
 
     columns = COLUMNS
 
-    def __init__(self, system, table=None, stream=STREAM):
-        p = system.params
-        self.system = system
+    def __init__(self, stack, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
+        super().__init__(stack, loading, relaxation)
+        p = params
         self.params = p
-        self.energy_unit = energy_unit(p, system.constants["h"])
+        self.energy_unit = energy_unit(p, constants["h"])
         self.beta = 1.0 / (p.temperature * self.energy_unit)
-        self.speed = p.drive_rate / drive_scale(system)
-        self.modes = shear_modes(system.mesh)
+        self.speed = p.drive_rate / drive_scale(loading.response, p.eps0, mesh)
+        self.modes = shear_modes(mesh)
+        self.overshoot = 0.5 * constants["deps"]
         self.header = {"protocol": "thermal", "temperature": p.temperature, "attempt_rate": p.attempt_rate,
                        "drive_rate": p.drive_rate, "hold_times": list(p.hold_times), "hold_delay": p.hold_delay,
                        "energy_unit": self.energy_unit}
@@ -166,26 +181,59 @@ class ThermalProtocol:
                                 np.array([self.stream + increment], dtype=np.uint64))
         return state, inc
 
-    def step(self, kick, margin, increment):
-        """The next increment: a load to the next event (``kick`` False) or that event; see the module docstring."""
-        if kick:
+    def step(self, event, margin, increment):
+        """The next increment: a load to the next event (``event`` False) or that event; see the module docstring."""
+        if event:
             return self._event(margin)
         return self._load(margin, increment)
 
+    def hop(self, block, direction, margin):
+        """Carry ``block`` over its edge in ``direction`` and relax; restore the state if it falls back.
+
+        Parameters
+        ----------
+        block : int
+            Interface element.
+        direction : int
+            :data:`.barriers.FORWARD` or backward.
+        margin : int
+            See :meth:`..relaxation.DynamicRelaxation.relax`.
+
+        Returns
+        -------
+        bool
+            True if some well index changed (the hop happened); False if the block fell back or its
+            shear mode cannot carry it over (the state is then as before).
+        """
+        stack = self.stack
+        shear = ShearHop(stack, self.modes, block, direction, self.overshoot)
+        if math.isnan(shear.step()):
+            return False
+        before = stack.stored()
+        index = stack.well_index()
+        niter, _ = self.perturb_and_relax(shear, margin)
+        if niter and stack.extend:
+            stack.hold_wells_ahead()
+        if np.array_equal(stack.well_index(), index):
+            stack.restore(*before)
+            return False
+        return True
+
     def _load(self, margin, increment):
-        system = self.system
-        model, state = system.model, system.state
-        start = system.snapshot()
+        stack = self.stack
+        start = stack.stored()
         t = start[3]
         stream = self._stream(increment)
-        ds_c = system.step_size(False)
-        allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
+        ds_c = self.loading.step_size(False)
+        allowed = np.ones((stack.model.epsy.shape[0], 2), dtype=bool)
         ds, held, failed = 0.0, 0.0, 0
         while True:
             holding, until = self.schedule.stretch(t)
             speed = 0.0 if holding else self.speed
+            model = stack.model  # a failed hop may have moved the held wells
+            idx, eps = stack.backend.read("idx", "eps")
             kind, block, direction, dt = sample_event(
-                model.law, model.epsy, state.idx, state.eps, system.delta_eps, model.iface_dV, allowed, self.beta,
+                model.law, model.epsy, idx, eps, self.loading.response.delta_eps, model.iface_dV, allowed, self.beta,
                 self.params.attempt_rate, ds, speed, until - t, ds_c, *stream)
             if holding:
                 held += dt
@@ -197,42 +245,40 @@ class ThermalProtocol:
             t += dt
             sign = 1 if direction == FORWARD else -1
             if kind != HOP:
-                system.event_step(False)
-                state.t[0] = t
+                self.loading.step(False)
+                stack.set_time(t)
                 self.pending = (-1, 0)
                 return {"yield_element": False, "hop_block": -1, "hop_direction": 0, "failed_hops": failed,
                         "held": held}
-            system.load(ds)
-            state.t[0] = t
-            loaded = system.snapshot()
-            if hop(system, self.modes, block, direction, margin):
-                state.t[0] = t  # avalanches take no time
-                self._after = system.snapshot()
-                system.restore(*loaded)
+            self.loading.load(ds)
+            stack.set_time(t)
+            loaded = stack.stored()
+            if self.hop(block, direction, margin):
+                stack.set_time(t)  # avalanches take no time
+                self._after = stack.stored()
+                stack.restore(*loaded)
                 self.pending = (block, sign)
                 return {"yield_element": False, "hop_block": block, "hop_direction": sign, "failed_hops": failed,
                         "held": held}
             failed += 1
             allowed[block, direction] = False
-            system.restore(*start)
+            stack.restore(*start)
 
     def _event(self, margin):
-        system = self.system
+        stack = self.stack
         block, sign = self.pending
-        t = float(system.state.t[0])
+        t = stack.time
         yield_element = False
         if block < 0:
-            converged, yield_element = system.kick(margin)
-            system.state.t[0] = t
+            converged, yield_element = self.kick(margin)
+            stack.set_time(t)
         else:
             if self._after is None:  # resumed at the load increment: redo the hop drawn there
-                if not hop(system, self.modes, block, FORWARD if sign > 0 else BACKWARD, margin):
-                    from ..system import SolverError
-
+                if not self.hop(block, FORWARD if sign > 0 else BACKWARD, margin):
                     raise SolverError(f"the stored hop of block {block} fell back when redone")
-                system.state.t[0] = t
-                self._after = system.snapshot()
-            system.restore(*self._after)
+                stack.set_time(t)
+                self._after = stack.stored()
+            stack.restore(*self._after)
         self.pending, self._after = None, None
         return {"yield_element": yield_element, "hop_block": block, "hop_direction": sign, "failed_hops": 0,
                 "held": 0.0}

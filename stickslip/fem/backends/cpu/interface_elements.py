@@ -1,12 +1,12 @@
 """Interface elements' force, vectorised over elements, for any interface law.
 
 The interface elements (one row of ``ni`` Quad4 elements per interface) are computed
-Gauss point by Gauss point as :func:`.quad4.element_strain`, :func:`.laws.well_index`
-and :func:`.laws.well_stress` (the law's scalar reference) prescribe, in the same order of
+Gauss point by Gauss point as :func:`stickslip.fem.quad4.element_strain`, :func:`stickslip.fem.laws.well_index`
+and :func:`stickslip.fem.laws.well_stress` (the law's scalar reference) prescribe, in the same order of
 operations (so the bits equal those of that scalar formulation), but with the elements as the
 inner, contiguous loop: the element data are stored field by field (:func:`interface_layout`)
 and one pass per Gauss point runs over the elements with loop-invariant rows, which LLVM
-vectorises. The law (:mod:`.laws`) is an argument: the kernels are compiled for its type, with
+vectorises. The law (:mod:`stickslip.fem.laws`) is an argument: the kernels are compiled for its type, with
 its stress factor inlined into the pass.
 
 A pass assumes that every Gauss point stays in its current well (the well's bounds are
@@ -17,9 +17,9 @@ Reference: shared/reference-model.md, sections 2 and 4.
 
 import numpy as np
 
-from ..numba_options import njit
-from .laws import deviatoric_factor, well_index
-from .materials import equivalent_strain
+from ....numba_options import njit
+from ...laws import deviatoric_factor, well_index
+from ...materials import equivalent_strain
 
 __all__ = ["interface_layout", "interface_force", "NIN", "NOUT"]
 
@@ -117,7 +117,7 @@ def interface_force(lo, hi, law, iface_dofs, grad, volume, epsy, u, idx, inp, ou
     lo, hi : int
         Element range.
     law : tuple
-        The interface law (:mod:`.laws`), e.g. ``Cusp(K, G)``.
+        The interface law (:mod:`stickslip.fem.laws`), e.g. ``Cusp(K, G)``.
     iface_dofs : numpy.ndarray
         int64 [ni, 8] DOFs of the elements.
     grad, volume : numpy.ndarray

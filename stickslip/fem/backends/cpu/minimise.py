@@ -9,7 +9,7 @@ sequence (the reference's ``minimise_boundcheck``: index ``>= ny - margin``).
 
 With ``quiet > 0`` it also stops (status ``QUIET``, not quenched) once ``quiet``
 consecutive steps changed no well index, so that the caller can try the equilibrium
-solve of ``relaxation = exact`` (:meth:`.system.System.minimise`) and call again.
+solve of ``relaxation = exact`` (:class:`stickslip.fem.relaxation.ExactRelaxation`) and call again.
 
 Recording (for the event maps): every change of the well index of Gauss point
 0 of an interface element is stored as one row per hop
@@ -19,19 +19,11 @@ Reference: shared/reference-model.md, section 8d.
 
 import numpy as np
 
-from ..numba_options import njit
+from ....numba_options import njit
+from ..base import CONVERGED, MARGIN, MAX_ITER_REACHED, QUIET
 from .dynamics import residual, time_step
 
-__all__ = ["minimise", "within_margin", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED"]
-
-#: Status of :func:`minimise`: the residual criterion was met (state quenched).
-CONVERGED = 1
-#: Status of :func:`minimise`: a Gauss point came within ``margin`` wells of the end of its sequence.
-MARGIN = 0
-#: Status of :func:`minimise`: ``quiet`` consecutive steps without any well change (not quenched).
-QUIET = 2
-#: Status of :func:`minimise`: ``max_iter`` steps did not converge.
-MAX_ITER_REACHED = -1
+__all__ = ["minimise", "within_margin"]
 
 
 @njit
@@ -62,7 +54,7 @@ def minimise(model, work, state, tol, niter_tol, max_iter, margin, record, quiet
     ----------
     model : Model
     work : CpuWork
-        The CPU backend's workspace (:mod:`.backends.cpu`).
+        The CPU backend's workspace (:mod:`.backend`).
     state : State
         Modified in place (forces must be up to date on entry).
     tol : float
@@ -78,13 +70,13 @@ def minimise(model, work, state, tol, niter_tol, max_iter, margin, record, quiet
     quiet : int, optional
         If > 0, also stop (returning ``QUIET``, without quench) once ``quiet``
         consecutive steps changed no well index of any Gauss point; the caller may then
-        solve for the equilibrium within the current wells (:mod:`.equilibrium`) and
+        solve for the equilibrium within the current wells (:mod:`stickslip.fem.equilibrium`) and
         call again to continue. 0: never (the paper's protocol).
 
     Returns
     -------
     status : int
-        ``CONVERGED`` (quenched), ``MARGIN``, ``QUIET`` or ``MAX_ITER_REACHED``.
+        :data:`..base.CONVERGED` (quenched), ``MARGIN``, ``QUIET`` or ``MAX_ITER_REACHED``.
     niter : int
         Steps made by this call.
     events : numpy.ndarray

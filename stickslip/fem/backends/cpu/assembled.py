@@ -1,7 +1,7 @@
 """Backend ``assembled`` (the reference): the plates' product by the assembled CSR matrix.
 
 The same kernels as the default backend but for the plates' product, row by row from the
-assembled stiffness (:func:`..assembly.assemble_csr`): its sums run in another order than
+assembled stiffness (:func:`stickslip.fem.assembly.assemble_csr`): its sums run in another order than
 the stencils', so its results differ from the default's by round-off, and a run with it has
 its own run id (the ``backend`` parameter of ``fem``).
 """
@@ -10,9 +10,9 @@ from collections import namedtuple
 
 from numba import prange
 
-from ...numba_options import njit
-from ..plates import register_plate_operator
-from .cpu import CpuBackend
+from ....numba_options import njit
+from .plates import register_plate_operator
+from .backend import CpuBackend
 
 __all__ = ["AssembledBackend", "CsrPlates"]
 

@@ -1,6 +1,6 @@
 """Backend ``structured`` (the default): the plates' product by periodic stencils over node lines.
 
-The plan and kernels of the stencil product are in :mod:`..structured`; this module makes
+The plan and kernels of the stencil product are in :mod:`.stencils`; this module makes
 them a plate operator of a CPU backend, serial or in parallel blocks (the same bits).
 """
 
@@ -9,10 +9,10 @@ from collections import namedtuple
 import numpy as np
 from numba import prange
 
-from ...numba_options import njit
-from ..plates import register_plate_operator
-from ..structured import apply_groups, build_stencils, gather_views, plan_blocks, plan_product, plate_product
-from .cpu import CpuBackend
+from ....numba_options import njit
+from .plates import register_plate_operator
+from .stencils import apply_groups, build_stencils, gather_views, plan_blocks, plan_product, plate_product
+from .backend import CpuBackend
 
 __all__ = ["StructuredBackend", "StencilPlates"]
 
@@ -42,13 +42,13 @@ def _product(plates, nblock, u, f):
 
 @register_plate_operator
 class StencilPlates(namedtuple("StencilPlates", [
-        "views", "groups", "triplet_ptr", "triplet_view", "triplet_coef",  # :class:`..structured.PlatePlan` arrays
+        "views", "groups", "triplet_ptr", "triplet_view", "triplet_coef",  # :class:`.stencils.PlatePlan` arrays
         "empty",         # int64 [nempty]: DOFs with an empty plate row
         "work",          # float64 [4, nwork]: scratch (views x, y; rows x, y)
         "view_blocks",   # int64 [nblock + 1]: view ranges of the parallel blocks (balanced)
         "group_blocks",  # int64 [nblock + 1]: group ranges of the parallel blocks (balanced)
 ])):
-    """The stencil plan of the plates' stiffness (:func:`..structured.plan_product`)."""
+    """The stencil plan of the plates' stiffness (:func:`.stencils.plan_product`)."""
 
     __slots__ = ()
     product = staticmethod(_product)

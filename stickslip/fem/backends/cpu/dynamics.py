@@ -16,10 +16,10 @@ Reference: shared/reference-model.md, section 5.
 
 from numba import prange
 
-from ..numba_options import njit
+from ....numba_options import njit
 from .forces import compute_force
 
-__all__ = ["time_step", "residual"]
+__all__ = ["time_step", "time_steps", "residual"]
 
 
 # The loops run over slices (non-negative indices: no wrap-around test), so that they vectorise.
@@ -95,7 +95,7 @@ def residual(model, state):
 
 @njit
 def time_step(model, work, state):
-    """Advance ``state`` by one time step ``model.dt`` (``work``: the CPU backend's :class:`.backends.cpu.CpuWork`)."""
+    """Advance ``state`` by one time step ``model.dt`` (``work``: the CPU backend's :class:`.backend.CpuWork`)."""
     state.t[0] += model.dt
     m = model
     if work.nblock > 1:
@@ -107,3 +107,10 @@ def time_step(model, work, state):
         _correct_parallel(work.nblock, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)
     else:
         _correct(0, m.ndof, m.dt, m.mass_inv, m.damping, state.f, state.v, state.a)
+
+
+@njit
+def time_steps(model, work, state, nsteps):
+    """Advance ``state`` by ``nsteps`` time steps (:func:`time_step`), without any stopping criterion."""
+    for _ in range(nsteps):
+        time_step(model, work, state)

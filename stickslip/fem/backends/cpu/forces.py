@@ -3,13 +3,13 @@
 ``f(u) = K_plates u + sum_interface int B^T sigma_law dV + f_drive`` on DOF vectors.
 The drive adds, on every layer ``l`` with an active spring, the uniform body
 force ``k (ubar_l - target_l)`` per unit volume (nodal equivalent
-``k (ubar_l - target_l) V_l w_l``, :mod:`.assembly`). With a free lever the
+``k (ubar_l - target_l) V_l w_l``, :mod:`stickslip.fem.assembly`). With a free lever the
 targets follow the lever's moment balance at every evaluation
 (``x_lever = (x_target + sum_l r_l ubar_l) / (1 + sum_l r_l^2)``,
 ``target_l = r_l x_lever``, ``r_l = h_l / H``, sums over driven layers).
 
-The kernels take the physics (``model``, :class:`.model.Model`, with its law) and the
-workspace of a CPU backend (``work``, :class:`.backends.cpu.CpuWork`: the plate operator,
+The kernels take the physics (``model``, :class:`stickslip.fem.model.Model`, with its law) and the
+workspace of a CPU backend (``work``, :class:`.backend.CpuWork`: the plate operator,
 which :func:`.plates.plate_force` applies, the interface elements' layout and scratch,
 the number of parallel blocks); they are compiled for the types of the law and of the plate
 operator. Deterministic whatever the number of threads: interface elements are computed
@@ -20,11 +20,11 @@ Reference: shared/reference-model.md, sections 2, 6 and 7.
 
 from numba import prange
 
-from ..numba_options import njit
+from ....numba_options import njit
 from .plates import plate_force
-from .interface import interface_force
-from .laws import well_index
-from .materials import equivalent_strain
+from .interface_elements import interface_force
+from ...laws import well_index
+from ...materials import equivalent_strain
 
 __all__ = ["interface_forces", "drive_force", "compute_force", "wells_hold", "layer_ubar"]
 
@@ -115,7 +115,7 @@ def compute_force(model, work, state, update_wells):
     update_wells : bool
         Move every Gauss point to the well of its strain. False: every Gauss point keeps its
         well ``state.idx`` whatever its strain, so that the force is the gradient of the energy of
-        the current wells (:mod:`.equilibrium`).
+        the current wells (:mod:`stickslip.fem.equilibrium`).
     """
     plate_force(work.plates, work.nblock, state.u, state.f)
     interface_forces(model, work, state, update_wells)
@@ -126,7 +126,7 @@ def compute_force(model, work, state, update_wells):
 def wells_hold(model, state):
     """True if every interface Gauss point's strain ``state.eps`` lies in its well ``state.idx``.
 
-    Uses :func:`.laws.well_index` on the stored strain, i.e. exactly the test that
+    Uses :func:`stickslip.fem.laws.well_index` on the stored strain, i.e. exactly the test that
     :func:`compute_force` would apply to the same displacement.
     """
     for e in range(state.idx.shape[0]):

@@ -1,4 +1,4 @@
-"""Structured plate kernel: the plates' stiffness product as periodic stencils over node lines.
+"""The stencil plan of the plates: their stiffness product as periodic stencils over node lines.
 
 The plates are rows of elements spanning the periodic length (:mod:`stickslip.mesh.rows`):
 regular rows of equal square elements and transition rows (4 quadrilaterals per coarse
@@ -12,7 +12,7 @@ coefficients. A regular line between two rows of equal squares has ``p = 1`` and
 nine-point stencil of the plane-strain Q4 element; lines at transition rows have
 ``p = 3`` (fine), ``2`` (middle nodes) or ``1`` (coarse) with their own stencils.
 
-The stencils are read from the assembled matrix (:func:`.assembly.assemble_csr`) at one
+The stencils are read from the assembled matrix (:func:`stickslip.fem.assembly.assemble_csr`) at one
 representative block per line and class and checked against every other block when built,
 so the product equals the assembled one up to the order of the sums (round-off; tested
 on random displacements for every mesh shape, periodic wrap included).
@@ -29,7 +29,7 @@ the CSR product at N = 1458 (docs/benchmarks.md).
 
 import numpy as np
 
-from ..numba_options import njit
+from ....numba_options import njit
 
 __all__ = ["PlateStencils", "PlatePlan", "build_stencils", "plan_product", "balanced_blocks", "plan_blocks",
            "gather_views", "apply_groups", "plate_product"]
@@ -86,7 +86,7 @@ def build_stencils(mesh, ptr, col, val):
     ----------
     mesh : stickslip.mesh.LayeredMesh
     ptr, col, val : numpy.ndarray
-        The assembled CSR matrix [ndof, ndof] of the plates (:func:`.assembly.assemble_csr`).
+        The assembled CSR matrix [ndof, ndof] of the plates (:func:`stickslip.fem.assembly.assemble_csr`).
 
     Returns
     -------

@@ -1,0 +1,114 @@
+"""Quasistatic loading of a stack along its linear response: elastic steps to the brink of yielding, kicks past it.
+
+The load direction (:class:`.linear_response.LinearResponse`) is given to the backend once
+(:meth:`.backends.base.Backend.set_load_direction`); a step along it moves the displacement and
+the drive together (:meth:`.backends.base.Backend.load`). The step to the brink, or just past
+it, is found on the host from the interface strain (:func:`.event_driven.step_size`).
+Reference: shared/reference-model.md, section 8a-8b.
+"""
+
+import numpy as np
+
+from .errors import SolverError
+from .event_driven import step_size
+
+__all__ = ["Loading", "KickAlongResponse"]
+
+
+class Loading:
+    """Steps of a stack along its linear response (elastic load steps and kicks).
+
+    Parameters
+    ----------
+    stack : stickslip.fem.stack.Stack
+    response : stickslip.fem.linear_response.LinearResponse
+    deps : float
+        Kick size in equivalent strain (:func:`.constants.derived_constants`).
+    """
+
+    def __init__(self, stack, response, deps):
+        self.stack = stack
+        self.response = response
+        self.deps = deps
+        stack.backend.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
+
+    def step_size(self, kick, yield_element=False):
+        """The step along the linear response that :meth:`step` makes (nothing is changed).
+
+        Parameters
+        ----------
+        kick : bool
+            Kick (smallest step that changes a well index) or elastic load step (largest step that changes none).
+        yield_element : bool
+            Kick until all Gauss points of one element change well.
+
+        Returns
+        -------
+        float
+            The step [in units of the linear response] (0: already at the brink).
+
+        Raises
+        ------
+        SolverError
+            If no yielding step exists.
+        """
+        m = self.stack.model
+        u, eps, idx = self.stack.backend.read("u", "eps", "idx")
+        r = self.response
+        step = step_size(m.epsy, m.iface_dofs, m.iface_dNdx, u, r.delta_u, eps, r.delta_eps, idx, self.deps, kick,
+                         yield_element and kick)
+        if step < 0.0:
+            raise SolverError("no step along the linear response makes a block yield")
+        return step
+
+    def load(self, step):
+        """Move the state by ``step`` along the linear response (displacement and drive; no dynamics)."""
+        self.stack.backend.load(step)
+
+    def step(self, kick, yield_element=False):
+        """Elastic load step to the brink of yielding, or kick past it (no dynamics).
+
+        Parameters
+        ----------
+        kick : bool
+        yield_element : bool
+            Kick until all Gauss points of one element change well.
+
+        Returns
+        -------
+        float
+            The step along the linear response (0: already at the brink).
+
+        Raises
+        ------
+        SolverError
+            If no yielding step exists or the step broke its promise (an index changed
+            during a load step, or none during a kick).
+        """
+        idx = self.stack.backend.read("idx")[0].copy()
+        step = self.step_size(kick, yield_element)
+        self.load(step)
+        changed = np.any(self.stack.backend.read("idx")[0] != idx)
+        if kick != changed:
+            raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
+                              f"{'did not change' if kick else 'changed'}")
+        return step
+
+
+class KickAlongResponse:
+    """The athermal kick, a perturbation: the smallest step along the linear response that makes a block yield.
+
+    Parameters
+    ----------
+    loading : Loading
+    yield_element : bool
+        Kick until all four Gauss points of one element change well (the fallback).
+    """
+
+    def __init__(self, loading, yield_element):
+        self.loading = loading
+        self.yield_element = yield_element
+
+    def apply(self):
+        """Kick the stack (:meth:`Loading.step`)."""
+        self.loading.step(True, self.yield_element)
