@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from stickslip.fem.backends import make_backend
-from stickslip.fem.laws import (LAWS, Cusp, Smooth, deviatoric_factor, energy_density, forward_barrier, well_energy,
-                                well_stress)
+from stickslip.fem.laws import (INTERFACE_LAWS, LAWS, Cusp, Elastic, Smooth, backward_barrier, deviatoric_factor,
+                                energy_density, forward_barrier, well_energy, well_stress)
+from stickslip.fem.materials import elastic_stress
 from stickslip.fem.materials import equivalent_strain
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.simulation import Simulation
@@ -71,13 +72,32 @@ def _barrier_by_search(law, eq):
     return max(f(0.5 * (a + b)), tilted.max()) - well_energy(law, eq, LO, HI)
 
 
-@pytest.mark.parametrize("name", sorted(LAWS))
+@pytest.mark.parametrize("name", sorted(INTERFACE_LAWS))
 def test_the_barrier_formula_is_the_maximum_of_the_tilted_well(name):
     law = LAWS[name](4.5, 1.0)
     scale = law.G * (0.5 * (HI - LO)) ** 2
     for eq in np.linspace(LO + 1e-7, HI - 1e-7, 41):
         assert forward_barrier(law, eq, LO, HI) == pytest.approx(_barrier_by_search(law, eq), rel=1e-6,
                                                                  abs=1e-9 * scale)
+
+
+def test_the_backward_barrier_is_the_mirrored_forward_one_for_symmetric_wells():
+    # the cusp's barrier over its back edge at constant load: G (eq - lo)^2 (module doc of laws.cusp)
+    law = Cusp(4.5, 1.0)
+    for eq in np.linspace(LO + 1e-7, HI - 1e-7, 9):
+        assert backward_barrier(law, eq, LO, HI) == pytest.approx(law.G * (eq - LO) ** 2, rel=1e-12)
+    for eq in np.linspace(LO + 1e-7, HI - 1e-7, 9):
+        assert backward_barrier(Smooth(4.5, 1.0), eq, LO, HI) == forward_barrier(Smooth(4.5, 1.0), LO + HI - eq, LO, HI)
+
+
+def test_the_elastic_law_is_the_plates_elasticity_whatever_the_wells_and_never_yields():
+    law = Elastic(4.5, 1.0)
+    assert "elastic" in LAWS and "elastic" not in INTERFACE_LAWS  # not a choice of interface_law
+    rng = np.random.default_rng(2)
+    for lo, hi in ((LO, HI), (-np.inf, np.inf), (0.0, 1e-9)):
+        strain = rng.uniform(-1e-3, 1e-3, 3)
+        assert well_stress(law, *strain, lo, hi) == pytest.approx(elastic_stress(*strain, 4.5, 1.0), rel=1e-14)
+    assert forward_barrier(law, 1e-4, LO, HI) == backward_barrier(law, 1e-4, LO, HI) == np.inf
 
 
 def test_the_barrier_vanishes_as_the_square_for_the_cusp_and_the_three_halves_power_for_the_smooth_law():

@@ -127,6 +127,22 @@ def _slips(table, N):
     return np.asarray(table["t"], dtype=np.float64)[kick & full]
 
 
+def _resumed(table, N, schedule):
+    """Replay the slips of a stored table into ``schedule``; return the hop pending after its last increment.
+
+    Returns
+    -------
+    tuple or None
+        ``(hop_block, hop_direction)`` of a last stored load increment (its event is next), else None.
+    """
+    table = {name: np.asarray(table[name]) for name in table}
+    for t in _slips(table, N):
+        schedule.slip(t)
+    if table["kick"][-1]:
+        return None
+    return int(table["hop_block"][-1]), int(table["hop_direction"][-1])
+
+
 class ThermalProtocol(AthermalProtocol):
     """Thermally activated hops with a finite drive rate (module docstring): the athermal protocol with its own steps.
 
@@ -162,14 +178,8 @@ class ThermalProtocol(AthermalProtocol):
                        "energy_unit": self.energy_unit}
         self.stream = int(stream)
         self.schedule = HoldSchedule(p.hold_times, p.hold_delay / p.drive_rate)
-        self.pending = None
+        self.pending = None if table is None else _resumed(table, p.N, self.schedule)
         self._after = None
-        if table is not None:
-            table = {name: np.asarray(table[name]) for name in table}
-            for t in _slips(table, p.N):
-                self.schedule.slip(t)
-            if not table["kick"][-1]:
-                self.pending = (int(table["hop_block"][-1]), int(table["hop_direction"][-1]))
 
     @staticmethod
     def initial_row():

@@ -1,0 +1,131 @@
+"""The fem core's seams, through the worked examples of docs/developing.md ("Extending the fem solver").
+
+The law example (``SoftCusp``) and the backend example (``CountingBackend``) are taken from the
+document as they are and run in a fresh Python (registering a law or a backend is global):
+
+- a new law is one module: with ``c = 1`` it is the cusp bit for bit, its parameter is checked by name;
+- the backend owns the state: the example backend counts every transfer between its state and the host
+  (what a device backend would copy). A whole event with the dynamic relaxation moves the same number
+  of arrays whatever its number of time steps; the exact relaxation adds exactly one exchange per
+  Newton iteration; a thermal increment goes through the same seam.
+"""
+
+import json
+import re
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "developing.md"
+
+pytestmark = pytest.mark.slow
+
+
+def _example(name):
+    """The python block of docs/developing.md that defines ``name``."""
+    blocks = re.findall(r"```python\n(.*?)```", DOC.read_text(), re.S)
+    found = [block for block in blocks if f"class {name}(" in block]
+    assert len(found) == 1, f"docs/developing.md: one example defining {name} expected"
+    return found[0]
+
+
+def _run(tmp_path, script):
+    """Run ``script`` in a fresh Python beside the two examples (as modules); returns its last line as JSON."""
+    (tmp_path / "soft_cusp.py").write_text(_example("SoftCusp"))
+    (tmp_path / "counting_backend.py").write_text(_example("CountingBackend"))
+    done = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+PRELUDE = """
+    import json
+    import numpy as np
+    import counting_backend, soft_cusp  # registering them is all it takes
+    from stickslip.fem.backends import make_backend
+    from stickslip.fem.parameters import FemParams
+    from stickslip.fem.simulation import Simulation
+    from stickslip.mesh import MeshParams, build_stack_mesh
+    from stickslip.params import ParameterError, parse_params
+
+    def events(sim, count):
+        rows = []
+        transfers = sim.stack.backend.transfers
+        for _ in range(count):
+            sim.loading.step(False)
+            before, t0 = dict(transfers), sim.stack.time
+            assert sim.protocol.kick(5)[0]
+            moved = {name: transfers[name] - before.get(name, 0) for name in transfers}
+            rows.append((round((sim.stack.time - t0) / sim.stack.model.dt), moved))
+        return rows
+"""
+
+
+def test_a_law_is_one_module_the_soft_cusp_at_c_one_is_the_cusp_bit_for_bit(tmp_path):
+    result = _run(tmp_path, PRELUDE + """
+    mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+    states = {}
+    for law, values in (("cusp", ()), ("soft-cusp", (1.0,))):
+        sim = Simulation(FemParams(N=9, plates=2, seed=2, interface_law=law, law_params=values,
+                                   relaxation="exact"), mesh, make_backend())
+        for _ in range(10):
+            sim.loading.step(False)
+            sim.protocol.kick(5)
+        states[law] = sim.stack.backend.read("u")[0].tobytes().hex()
+    soft = Simulation(FemParams(N=9, plates=2, interface_law="soft-cusp", law_params=(0.5,)), mesh,
+                      make_backend())
+    errors = []
+    for values in ((), (1.5,)):
+        try:
+            parse_params(FemParams, {"interface_law": "soft-cusp", "law_params": values})
+        except ParameterError as error:
+            errors.append(str(error))
+    print(json.dumps({"same": states["cusp"] == states["soft-cusp"], "errors": errors,
+                      "law": repr(soft.stack.model.law)}))
+    """)
+    assert result["same"]
+    assert result["law"] == "SoftCusp(K=4.5, G=1.0, c=0.5)"
+    assert all(error.startswith("parameter 'law_params'") for error in result["errors"])
+    assert "takes 1 parameters after K and G: expected the values of (c), got 0" in result["errors"][0]
+    assert "c = 1.5 is outside (0, 1]" in result["errors"][1]
+
+
+def test_the_backend_owns_the_state_transfers_per_event_do_not_grow_with_the_time_steps(tmp_path):
+    result = _run(tmp_path, PRELUDE + """
+    mesh = build_stack_mesh(MeshParams(N=18, plates=3))
+    out = {}
+    for relaxation in ("dynamic", "exact"):
+        params = FemParams(N=18, plates=3, seed=1, k_drive=1e-4, relaxation=relaxation, backend="counting")
+        out[relaxation] = events(Simulation(params, mesh, make_backend("counting")), 12)
+    hot = FemParams(N=9, plates=2, seed=1, k_drive=1e-3, relaxation="exact", dt_scale=4.0, temperature=2e-3,
+                    drive_rate=1e-5, backend="counting")
+    sim = Simulation(hot, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend("counting"))
+    transfers = sim.stack.backend.transfers
+    thermal = []
+    for increment in range(1, 21):
+        before = dict(transfers)
+        row = sim.protocol.step(increment % 2 == 0, 5, increment)
+        moved = {name: transfers[name] - before.get(name, 0) for name in transfers}
+        thermal.append((row["hop_block"], sum(moved.values()) - moved.get("correct", 0)))
+    out["thermal"] = thermal
+    print(json.dumps(out))
+    """)
+    dynamic, exact = result["dynamic"], result["exact"]
+    steps = [n for n, _ in dynamic]
+    assert max(steps) > 2 * min(steps) > 1000  # events of very different lengths
+    counts = {sum(moved.values()) for _, moved in dynamic}
+    assert len(counts) == 1 and counts.pop() < 40  # the same few arrays per event, whatever its length
+    assert all(set(k for k, v in moved.items() if v) == {"read"} for _, moved in dynamic)
+    # exact: the same transfers as a dynamic event plus one exchange (force out, correction in) per Newton iteration
+    for _, moved in exact:
+        assert moved["correct"] > 0
+        assert sum(moved.values()) - moved["correct"] == sum(dynamic[0][1].values())
+    # thermal increments go through the seam too (hops and threshold kicks): besides the Newton iterations of the
+    # exact relaxation, a few dozen arrays per increment
+    thermal = result["thermal"]
+    assert any(block >= 0 for block, _ in thermal) and any(block < 0 for block, _ in thermal)
+    assert max(count for _, count in thermal) < 60
