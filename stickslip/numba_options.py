@@ -17,8 +17,14 @@ Notes
 ``fastmath`` stays off: reordering floating-point operations would break the
 bit-identical reproducibility promised for the same parameters and seed.
 
-numba's on-disk cache has three defects, worked around here on import:
+numba's on-disk cache has four defects, worked around here on import:
 
+- Entries for types of other programs: a kernel compiled for a type defined outside the
+  package (a law registered by a user's module or notebook) is cached beside the package's own
+  entries, and numba unpickles a function's whole index on every load: a process that cannot
+  import that module then fails with ``ModuleNotFoundError`` in any kernel of that function.
+  :func:`tolerate_foreign_entries` reads such an index as empty (a cache miss: the kernel is
+  compiled and the index rewritten with this process's entries).
 - Stale callees: numba keys a cached kernel by its own source file only, so a kernel
   that calls (and inlines) code of another module, e.g. an interface law
   (:mod:`stickslip.fem.laws`) or a backend's plate operator, would keep running the old
@@ -85,6 +91,28 @@ def serialise_cache_writes():
 
     locked_save.serialised = True
     caching.IndexDataCacheFile.save = locked_save
+
+
+def tolerate_foreign_entries():
+    """Read a cache index that names a type this process cannot import as empty (a cache miss).
+
+    Wraps ``numba.core.caching.IndexDataCacheFile._load_index`` (numba pinned in environment.txt):
+    unpickling an entry whose type lives in a module this process cannot import (or that no longer
+    defines it) raises ``ImportError`` or ``AttributeError``; the index is then treated as absent.
+    Idempotent.
+    """
+    load = caching.IndexDataCacheFile._load_index
+    if getattr(load, "tolerant", False):
+        return
+
+    def tolerant_load(self):
+        try:
+            return load(self)
+        except (ImportError, AttributeError):
+            return {}
+
+    tolerant_load.tolerant = True
+    caching.IndexDataCacheFile._load_index = tolerant_load
 
 
 def start_threading_layer():
@@ -167,6 +195,7 @@ def key_cache_on_subpackage():
 
 
 key_cache_on_subpackage()
+tolerate_foreign_entries()
 serialise_cache_writes()
 start_threading_layer()
 
