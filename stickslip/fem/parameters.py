@@ -103,6 +103,19 @@ class FemParams:
     hold_delay: float = param(0.0, "temperature > 0 with hold_times: the drive's advance after a slip event at "
                                    "which the hold starts (a slip before it postpones the hold)", unit="eps0",
                               minimum=0.0, extension="temperature")
+    junction_strengthening: float = param(0.0, "junction aging (docs/fem.md, 'Junction aging'): the half-width of a "
+                                               "block's current well grows by this times the depth E of its contact "
+                                               "junction, its centre fixed; 0: no aging (needs temperature > 0 and "
+                                               "a law whose stress depends on the well's centre only, the cusp)",
+                                          unit="eps0 / (G eps0^2 h^2)", minimum=0.0, extension=True)
+    junction_glass_temperature: float = param(8e-3, "junction aging: scale T_g of the depths drawn, rho(E) = "
+                                                    "exp(-E / T_g) / T_g, when a block enters a well and at every "
+                                                    "redraw; the typical depth grows as temperature x ln t below T_g",
+                                              unit="G eps0^2 h^2", exclusive_minimum=0.0,
+                                              extension="junction_strengthening")
+    junction_attempt_rate: float = param(1.0, "junction aging: a junction of depth E is redrawn at rest at the rate "
+                                              "nu_j exp(-E / temperature)", unit="1/time", exclusive_minimum=0.0,
+                                         extension="junction_strengthening")
 
     def check(self):
         """Check conditions across fields."""
@@ -115,10 +128,26 @@ class FemParams:
                 if getattr(self, name) != field.default:
                     raise ParameterError(f"parameter '{name}': used only with temperature > 0; expected a "
                                          "temperature > 0 or the default")
+        self._check_junctions()
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
 
+
+    def _check_junctions(self):
+        if self.junction_strengthening == 0.0:
+            for name in ("junction_glass_temperature", "junction_attempt_rate"):
+                if getattr(self, name) != self.__dataclass_fields__[name].default:
+                    raise ParameterError(f"parameter '{name}': used only with junction_strengthening > 0; expected "
+                                         "junction_strengthening > 0 or the default")
+            return
+        if self.temperature == 0.0:
+            raise ParameterError("parameter 'junction_strengthening': junction aging needs thermal activation; "
+                                 "expected temperature > 0 or junction_strengthening = 0")
+        if not getattr(INTERFACE_LAWS[self.interface_law], "junction_aging", False):
+            raise ParameterError(f"parameter 'junction_strengthening': law '{self.interface_law}' has a stress that "
+                                 "depends on the well's width, so a junction cannot widen it at rest; expected "
+                                 "interface_law 'cusp' or junction_strengthening = 0")
 
     def _check_law(self):
         law = INTERFACE_LAWS[self.interface_law]

@@ -7,6 +7,9 @@ loop of :mod:`.run`. Its interface:
     dict name -> numpy dtype of the columns it adds to the increment table;
 ``header``
     dict of the root attributes it adds to the run file;
+``state_fields``
+    dict name -> (shape, dtype) of further state it stores per increment beside the stack's
+    displacement, drive and clock (the fifth item of :meth:`.stack.Stack.stored`, e.g. the junctions);
 ``initial_row()``
     its columns for increment 0;
 ``step(event, margin, increment)``
@@ -41,6 +44,7 @@ class AthermalProtocol:
 
     columns = {}
     header = {}
+    state_fields = {}
 
     def __init__(self, stack, loading, relaxation):
         self.stack = stack

@@ -95,7 +95,7 @@ def _create(path, params, mesh, backend, producer):
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
             create_file(file, _header(simulation, observer, producer), mesh, simulation.loading.response,
-                        columns + list(protocol.columns), protocol.columns)
+                        columns + list(protocol.columns), protocol.columns, protocol.state_fields)
             append_increment(file, simulation.stack.stored(),
                              _row(observer, 0, True, observer.well_index(),
                                   {"yield_element": False, **protocol.initial_row()}))

@@ -11,13 +11,14 @@ from .loading import Loading
 from .protocol import AthermalProtocol
 from .relaxation import make_relaxation
 from .stack import build_stack
-from .thermal import ThermalProtocol
+from .thermal import thermal_protocol
 
 __all__ = ["Simulation", "make_protocol"]
 
 
 def make_protocol(simulation, table=None):
-    """The protocol of a simulation's parameters: athermal, or thermal for ``temperature > 0``.
+    """The protocol of a simulation's parameters: athermal, or thermal for ``temperature > 0`` (with junction aging
+    if ``junction_strengthening > 0``).
 
     Parameters
     ----------
@@ -27,7 +28,7 @@ def make_protocol(simulation, table=None):
     """
     s = simulation
     if s.params.temperature > 0.0:
-        return ThermalProtocol(s.stack, s.loading, s.relaxation, s.params, s.mesh, s.constants, table)
+        return thermal_protocol(s.stack, s.loading, s.relaxation, s.params, s.mesh, s.constants, table)
     return AthermalProtocol(s.stack, s.loading, s.relaxation)
 
 

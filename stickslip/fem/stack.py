@@ -5,6 +5,8 @@ the backend holds a window of it and numbers the wells from the window's start. 
 keeps the two in step: a well's global index is the held index plus the window's offset, and
 with ``yield_strains = extend`` the windows are moved ahead of the Gauss points after every event
 (:meth:`Stack.hold_wells_ahead`), always through the backend (:meth:`.backends.base.Backend.set_yield_strains`).
+With junction aging (:mod:`.thermal.junctions`) the yield strains the backend holds are that window with
+every junction's well widened (:meth:`Stack.push_yield_strains`), and a stored state includes the junctions.
 """
 
 import numpy as np
@@ -13,6 +15,7 @@ from .errors import SolverError
 from .laws import make_law
 from .materials import equivalent_strains
 from .model import build_model
+from .thermal.junctions import Junctions
 from .yield_strains import HeldYieldStrains, interface_initstate
 
 __all__ = ["Stack", "build_stack"]
@@ -29,16 +32,20 @@ class Stack:
         The held windows of the blocks' yield-strain sequences; ``backend.model.epsy`` is ``wells.epsy``.
     extend : bool
         ``yield_strains = extend``: the windows follow the Gauss points (else they hold the whole sequence).
+    junctions : stickslip.fem.thermal.junctions.Junctions, optional
+        Junction aging: the junctions that widen the blocks' current wells (None: no aging; then
+        ``backend.model.epsy`` is ``wells.epsy``).
 
     Attributes
     ----------
-    backend, wells, extend
+    backend, wells, extend, junctions
     """
 
-    def __init__(self, backend, wells, extend):
+    def __init__(self, backend, wells, extend, junctions=None):
         self.backend = backend
         self.wells = wells
         self.extend = extend
+        self.junctions = junctions
 
     @property
     def model(self):
@@ -63,11 +70,13 @@ class Stack:
         return bool(np.all(self.backend.read("idx")[0] < self.wells.epsy.shape[1] - margin))
 
     def stored(self):
-        """Copies of what :meth:`restore` needs, the state stored per increment: (u, target, lever_target, t)."""
+        """Copies of what :meth:`restore` needs, the state stored per increment: (u, target, lever_target, t),
+        and with junctions their state (:meth:`.thermal.junctions.Junctions.stored`) as a fifth item."""
         u, target, lever, t = self.backend.read("u", "target", "lever", "t")
-        return u.copy(), target.copy(), float(lever[0]), float(t[0])
+        state = (u.copy(), target.copy(), float(lever[0]), float(t[0]))
+        return state if self.junctions is None else (*state, self.junctions.stored())
 
-    def restore(self, u, target, lever_target, t):
+    def restore(self, u, target, lever_target, t, junctions=None):
         """Set a stored state (at rest) and, with ``extend``, move the windows to it (:meth:`hold_wells_ahead`).
 
         Parameters
@@ -80,15 +89,31 @@ class Stack:
             Free lever: drive target ``x_target``.
         t : float
             Time.
+        junctions : dict, optional
+            The junctions' state (:meth:`.thermal.junctions.Junctions.stored`), set before the displacement.
         """
+        if junctions is not None:
+            self.junctions.restore(junctions)
+            self.push_yield_strains()
         self.backend.set_state(u, target, lever_target, t)
         if self.extend:
             self.hold_wells_ahead()
 
+    def push_yield_strains(self, shift=None):
+        """Give the backend the yield strains it holds: the window, each junction's well widened (if any).
+
+        Parameters
+        ----------
+        shift : numpy.ndarray, optional
+            int64 [ni]: the windows moved forward by this many values (:meth:`.backends.base.Backend.set_yield_strains`).
+        """
+        epsy = self.wells.epsy if self.junctions is None else self.junctions.aged(self.wells)
+        self.backend.set_yield_strains(epsy, shift)
+
     def widen_wells(self):
         """Hold twice as many wells per block (the window's start unchanged)."""
         self.wells.widen(self.wells.epsy.shape[1] - 1)
-        self.backend.set_yield_strains(self.wells.epsy)
+        self.push_yield_strains()
 
     def hold_wells_ahead(self):
         """``yield_strains = extend``: hold at least half a window of wells ahead of every Gauss point.
@@ -105,7 +130,7 @@ class Stack:
         if np.any((wells.offset > 0) & (idx.min(axis=1) == 0)
                   & (equivalent_strains(eps).min(axis=1) <= wells.epsy[:, 0])):
             wells.start(wells.epsy.shape[1] - 1)
-            self.backend.set_yield_strains(wells.epsy)
+            self.push_yield_strains()
         while True:
             ny = wells.epsy.shape[1]
             ahead, behind = (ny - 1) // 2, (ny - 1) // 4
@@ -119,7 +144,7 @@ class Stack:
                 self.widen_wells()
                 continue
             wells.slide(shift)
-            self.backend.set_yield_strains(wells.epsy, shift)
+            self.push_yield_strains(shift)
 
 
 def build_stack(params, mesh, backend, constants):
@@ -137,6 +162,7 @@ def build_stack(params, mesh, backend, constants):
     Returns
     -------
     Stack
+        With :class:`.thermal.junctions.Junctions` if ``junction_strengthening > 0`` (none drawn yet).
 
     Raises
     ------
@@ -156,4 +182,8 @@ def build_stack(params, mesh, backend, constants):
                         rho=params.rho, alpha=constants["alpha"], dt=constants["dt"], k_drive=params.k_drive,
                         drive_active=~plastic & (np.arange(mesh.nlayer) > 0), free_lever=params.drive == "free-lever",
                         lever_height=constants["H"])
-    return Stack(backend.prepare(model, mesh), wells, extend)
+    junctions = None
+    if params.junction_strengthening > 0.0:
+        junctions = Junctions(wells.epsy.shape[0], params.junction_strengthening, params.junction_glass_temperature,
+                              params.junction_attempt_rate, params.eps0)
+    return Stack(backend.prepare(model, mesh), wells, extend, junctions)

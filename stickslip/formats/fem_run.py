@@ -27,7 +27,9 @@ equal runs give equal bytes):
     ``delta_target`` [nlayer], ``delta_lever`` [1].
 ``/state``
     One row per increment, enough to restore it: ``u`` [ninc, ndof], ``target``
-    [ninc, nlayer], ``lever_target`` [ninc], ``t`` [ninc].
+    [ninc, nlayer], ``lever_target`` [ninc], ``t`` [ninc]; and any further state the producer
+    declares (``create_file``'s ``state_fields``, e.g. ``fem`` with junction aging:
+    ``junction_depth``, ``junction_well`` [ninc, ni]), which files without it lack.
 ``/increments``
     The observables table (one 1-D dataset per column, attribute ``columns``,
     readable by :func:`stickslip.h5io.read_table`): ``increment``, ``kick``,
@@ -98,7 +100,7 @@ def _check_header(header):
         raise ValueError(f"fem-run header: regime must be one of {', '.join(REGIMES)}, got {header['regime']!r}")
 
 
-def create_file(file, header, mesh, linear_response, columns, dtypes=None):
+def create_file(file, header, mesh, linear_response, columns, dtypes=None, state_fields=None):
     """Write the header of a new ``fem-run`` file (no increment yet).
 
     Parameters
@@ -115,6 +117,9 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None):
         Columns of the observables table after ``increment``, ``kick``, ``yield_element``.
     dtypes : Mapping[str, numpy.dtype], optional
         Types of columns that are neither float64 nor the well counts ``S_*``, ``A_*`` (int64).
+    state_fields : Mapping[str, tuple], optional
+        Further state stored per increment: name -> ``(shape, dtype)`` of one increment's value
+        (datasets ``/state/<name>``; :func:`append_increment` takes their values as a fifth item).
 
     Raises
     ------
@@ -137,6 +142,9 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None):
     write_dataset(state, "target", np.zeros((0, nlayer)), maxshape=(None, nlayer), chunks=(64, nlayer))
     for name in ("lever_target", "t"):
         write_dataset(state, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
+    for name, (shape, dtype) in (state_fields or {}).items():
+        shape = tuple(shape)
+        write_dataset(state, name, np.zeros((0, *shape), dtype=dtype), maxshape=(None, *shape), chunks=(1, *shape))
     table = file.create_group("increments")
     columns = ["increment", "kick", "yield_element"] + list(columns)
     dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool, **(dtypes or {})}
@@ -163,11 +171,14 @@ def append_increment(file, state, row):
     ----------
     file : h5py.File
     state : tuple
-        ``(u [ndof], target [nlayer], lever_target, t)``: what restores the increment.
+        ``(u [ndof], target [nlayer], lever_target, t)``: what restores the increment; with further
+        state (``create_file``'s ``state_fields``) a fifth item, a mapping of their values.
     row : dict
         ``increment``, ``kick``, ``yield_element`` and the observables.
     """
     for name, value in zip(_STATE, state):
+        _append(file["state"][name], value)
+    for name, value in (state[4] if len(state) > 4 else {}).items():
         _append(file["state"][name], value)
     table = file["increments"]
     for name in json.loads(table.attrs["columns"]):
@@ -259,12 +270,16 @@ class RunFile:
         self.nstored = int(file.attrs["nstored"])
 
     def state(self, increment):
-        """(u, target, lever_target, t) of a stored increment."""
+        """(u, target, lever_target, t) of a stored increment; a file with further state adds a mapping of it."""
         if not 0 <= increment < self.nstored:
             raise FileFormatError(f"{self.file.filename}: increment {increment} is not stored "
                                   f"(0 ... {self.nstored - 1})")
         u, target, lever_target, t = (read_array(self.file["state"][name], increment) for name in _STATE)
-        return u, target, float(lever_target), float(t)
+        further = {name: read_array(self.file["state"][name], increment) for name in self._further()}
+        return (u, target, float(lever_target), float(t)) + ((further,) if further else ())
+
+    def _further(self):
+        return [name for name in sorted(self.file["state"]) if name not in _STATE]
 
     def increments(self):
         """The observables table of the stored increments (pandas.DataFrame, :func:`read_increments`)."""
@@ -272,7 +287,7 @@ class RunFile:
 
     def increment_bytes(self):
         """Bytes that appending one increment may allocate at most: one new chunk of every growing dataset [B]."""
-        datasets = [self.file["state"][name] for name in _STATE]
+        datasets = [self.file["state"][name] for name in (*_STATE, *self._further())]
         datasets += [self.file["increments"][name] for name in json.loads(self.file["increments"].attrs["columns"])]
         return sum(int(np.prod(d.chunks)) * d.dtype.itemsize for d in datasets)
 

@@ -46,6 +46,7 @@ class Cusp(namedtuple("Cusp", ("K", "G"))):
     yields = True
     exact_relaxation = True
     thermal = True
+    junction_aging = True  # the stress depends on the well's centre only: widening a well about it changes none
     deviatoric_factor = staticmethod(_deviatoric_factor)
     well_energy = staticmethod(_well_energy)
     forward_barrier = staticmethod(_forward_barrier)

@@ -28,7 +28,9 @@ choice of the ``interface_law`` parameter; the elastic law has not), ``exact_rel
 curvature in every well is bounded from above by the elastic stiffness of ``newton_moduli()``, which
 the exact relaxation's modified Newton iterations need, :mod:`..equilibrium`) and ``thermal`` (its
 backward barrier is exact and its barriers are quasi-concave in ``eps_eq`` within a well, which the
-exact sampling of :mod:`..thermal` needs). Parameters after ``K`` and ``G`` (its ``extra``
+exact sampling of :mod:`..thermal` needs); optionally ``junction_aging`` (its stress in a well depends on
+the well's centre only, so that a junction widening the current well about its centre changes no
+stress, :mod:`..thermal.junctions`; absent means False). Parameters after ``K`` and ``G`` (its ``extra``
 fields, given by the ``law_params`` parameter of ``fem``) are documented in ``parameter_docs`` and
 checked by ``check_parameters()``.
 

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..observables import Observer
 from .barriers import FORWARD, block_barriers
-from .protocol import STREAM, ThermalProtocol, drive_scale
+from .aging import thermal_protocol
+from .protocol import STREAM, drive_scale
 
 __all__ = ["hold_trial", "MAX_EVENTS", "REPLICAS"]
 
@@ -73,8 +74,8 @@ def hold_trial(simulation, state, hold_time, below, replica):
     ds_c = s.loading.step_size(False)
     s.loading.load(max(ds_c - below / drive_scale(s.loading.response, p.eps0, s.mesh), 0.0))
     observer = Observer(s)
-    protocol = ThermalProtocol(s.stack, s.loading, s.relaxation, p, s.mesh, s.constants,
-                               stream=STREAM + REPLICAS * (replica + 1))
+    protocol = thermal_protocol(s.stack, s.loading, s.relaxation, p, s.mesh, s.constants,
+                                stream=STREAM + REPLICAS * (replica + 1))
     unit = protocol.energy_unit * p.temperature
     t0 = s.stack.time
     protocol.schedule.hold_now(t0, hold_time)
