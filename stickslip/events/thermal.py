@@ -21,7 +21,12 @@ experiment done on its stored states:
   slip increments, evenly spaced, each held
   for every one of ``hold_times`` at a load ``below`` under its athermal threshold and reloaded
   (:mod:`stickslip.fem.thermal.holds`, through the solver's replay), paired: every hold time of a
-  state draws from the same random stream.
+  state draws from the same random stream;
+- **aging trials** (extension parameters, off by default; :mod:`.aging_trials`): the hold trials at
+  further loads ``hold_loads`` (then ``holds`` has a column ``below``), every slip after them until
+  each interface has slipped ``each`` times (table ``trial_slips``), and aftershock holds after
+  ``aftershock_states`` slips of every interface with their controls (``aftershock_trials``,
+  ``aftershocks``).
 
 Output (format ``event-table``): ``slip_events`` (the normalised table; further columns ``T``,
 ``hold``, ``B_a``, ``mu_before``, ``dgamma``), ``interfaces`` (``a``, ``R_tot``, ``dR_sum`` [well hops],
@@ -47,6 +52,7 @@ from ..h5io import FileFormatError
 from ..params import param
 from ..registry import register
 from . import extraction
+from .aging_trials import aftershock_tables, trial_slip_table
 from .fronts import solver_replay
 from .plugin import event_attrs
 
@@ -66,6 +72,17 @@ class ThermalEventParams:
     below: float = param(0.02, "hold trials: imposed shear between the held load and the athermal threshold",
                          unit="eps0", minimum=0.0)
     hold_interfaces: int = param(1, "hold trials only in runs with this many interfaces (0: every run)", minimum=0)
+    hold_loads: tuple[float, ...] = param((), "aging trials: further loads of the hold trials below the athermal "
+                                              "threshold (every state held at `below` and at each of these)",
+                                          unit="eps0", minimum=0.0, extension=True)
+    each: int = param(0, "aging trials: after a hold, drive on until every interface has slipped this many times "
+                         "and record every slip (table trial_slips); 0: the trial ends at the first slip",
+                      minimum=0, extension=True)
+    aftershock_states: int = param(0, "aging trials: steady-state slips of every interface held at their post-slip "
+                                      "load, each with a control hold mid-stick at the same stress (tables "
+                                      "aftershock_trials, aftershocks); 0: none", minimum=0, extension=True)
+    aftershock_time: float = param(1e12, "aging trials: duration of every aftershock and control hold",
+                                   unit="1/attempt_rate", exclusive_minimum=0.0, extension="aftershock_states")
 
 
 def _slip_rows(classified, N, a):
@@ -141,33 +158,39 @@ def interface_table(classified, N):
     return pd.DataFrame(rows, columns=["a", "R_tot", "dR_sum", "R_slow", "n_slips"])
 
 
-def hold_tables(hold, states, params, T0, n_interfaces):
+def hold_tables(hold, states, params, T0, n_interfaces, results=None):
     """The hold trials of a thermal run (module docstring).
 
     Parameters
     ----------
     hold : callable
-        ``hold(increment, hold_time, below, replica)``: :meth:`stickslip.fem.replay.EventReplay.hold`.
+        ``hold(increment, hold_time, below, replica, each)``: :meth:`stickslip.fem.replay.EventReplay.hold`.
     states : Sequence[int]
         Stored increments to hold (one replica each).
     params : ThermalEventParams
     T0 : float
         ``1 / attempt_rate`` (the unit of ``params.hold_times``).
     n_interfaces : int
+    results : list, optional
+        Filled with every trial's result (:func:`stickslip.fem.thermal.holds.hold_trial`), in trial order.
 
     Returns
     -------
     tuple[pandas.DataFrame, pandas.DataFrame, pandas.DataFrame]
-        ``holds``, ``creep``, ``barriers``.
+        ``holds`` (with ``below`` if ``params.hold_loads``), ``creep``, ``barriers``.
     """
     holds, creep, barriers = [], [], []
     names = [f"R_{a}" for a in range(1, n_interfaces + 1)]
-    bar = progress.bar(len(states) * len(params.hold_times), desc="hold trials", unit="trial")
+    loads = (params.below, *params.hold_loads)
+    bar = progress.bar(len(states) * len(params.hold_times) * len(loads), desc="hold trials", unit="trial")
     for replica, state in enumerate(states):
-        for hold_time in params.hold_times:
+        for below, hold_time in ((below, hold_time) for below in loads for hold_time in params.hold_times):
             trial = len(holds)
-            result = hold(int(state), hold_time * T0, params.below, replica)
+            result = hold(int(state), hold_time * T0, below, replica, params.each)
+            if results is not None:
+                results.append(result)
             holds.append({"trial": trial, "state": int(state), "replica": replica, "hold_time": hold_time * T0,
+                          **({"below": below} if params.hold_loads else {}),
                           **{k: result[k] for k in ("peak", "interface", "mu_start", "failed_in_hold", "t_slip",
                                                     "hold_hops", "events")}})
             rows = result["creep"]
@@ -178,8 +201,8 @@ def hold_tables(hold, states, params, T0, n_interfaces):
                                           "start": result["barriers_start"], "end": result["barriers_end"]}))
             bar.update(1)
     bar.close()
-    columns = ["trial", "state", "replica", "hold_time", "peak", "interface", "mu_start", "failed_in_hold", "t_slip",
-               "hold_hops", "events"]
+    columns = ["trial", "state", "replica", "hold_time", *(["below"] if params.hold_loads else []), "peak",
+               "interface", "mu_start", "failed_in_hold", "t_slip", "hold_hops", "events"]
     holds = pd.DataFrame(holds, columns=columns).astype({"trial": np.int64, "state": np.int64,
                                                          "replica": np.int64, "interface": np.int64,
                                                          "failed_in_hold": bool, "hold_hops": np.int64,
@@ -208,16 +231,24 @@ def run(params, input, output):
     T0 = 1.0 / float(run_attrs["attempt_rate"]) if thermal else None
     slips = slip_table(increments, classified, N, T0=T0)
     steady_slips = np.unique(slips["increment"].to_numpy())
-    states = []
-    if thermal and params.states and steady_slips.size and params.hold_interfaces in (0, n):
+    states, trials = [], []
+    holding = bool(thermal and params.states and steady_slips.size and params.hold_interfaces in (0, n))
+    replay = solver_replay(input, NAME) if holding or (thermal and params.aftershock_states) else None
+    if holding:
         pick = np.unique(np.linspace(0, steady_slips.size - 1, min(params.states, steady_slips.size)).round())
         states = steady_slips[pick.astype(np.int64)]
-        replay = solver_replay(input, NAME)
-        holds, creep, barriers = hold_tables(replay.hold, states, params, T0, n)
+        holds, creep, barriers = hold_tables(replay.hold, states, params, T0, n, trials)
     else:
         holds, creep, barriers = hold_tables(None, [], params, 1.0, n)
+    tables = {"slip_events": slips, "interfaces": interface_table(classified, N), "holds": holds, "creep": creep,
+              "barriers": barriers}
+    if params.each:
+        tables["trial_slips"] = trial_slip_table(trials)
+    if params.aftershock_states:
+        tables["aftershock_trials"], tables["aftershocks"] = aftershock_tables(
+            replay.aftershocks if replay is not None else None, increments["t"].to_numpy(dtype=float), classified,
+            slips, n, params.aftershock_states, params.aftershock_time * (T0 or 1.0))
     attrs = {**event_attrs(run_attrs, classified, source=str(input)), "thermal": thermal,
              "T0": T0 if thermal else np.nan}
     write_analysis_file(output, "event-table", analysis=NAME, version=VERSION, params=params, input=input,
-                        attrs=attrs, tables={"slip_events": slips, "interfaces": interface_table(classified, N),
-                                             "holds": holds, "creep": creep, "barriers": barriers})
+                        attrs=attrs, tables=tables)

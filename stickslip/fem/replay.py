@@ -6,7 +6,8 @@ model is built once per run file; each replay restores the stored state before t
 and runs the same kick and relaxation as the run
 (:meth:`.protocol.AthermalProtocol.perturb_and_relax` with :class:`.loading.KickAlongResponse`).
 For a thermal run it also holds a stored state at a load and reloads it
-(:meth:`EventReplay.hold`, :mod:`.thermal.holds`).
+(:meth:`EventReplay.hold`, :mod:`.thermal.holds`), or holds it at its load and records the events
+(:meth:`EventReplay.aftershocks`, :mod:`.thermal.aftershocks`).
 """
 
 import numpy as np
@@ -19,6 +20,7 @@ from .loading import KickAlongResponse
 from .parameters import stored_params
 from .simulation import Simulation
 from .thermal import hold_trial
+from .thermal.aftershocks import aftershock_trial
 
 __all__ = ["EventReplay"]
 
@@ -56,7 +58,11 @@ class EventReplay:
         with open_file(self.path) as file:
             return RunFile(file).state(increment)
 
-    def hold(self, increment, hold_time, below, replica):
+    def _thermal(self):
+        if self.params.temperature <= 0.0:
+            raise FileFormatError(f"{self.path}: an athermal run (temperature = 0) has no hold trials")
+
+    def hold(self, increment, hold_time, below, replica, each=0):
         """A hold trial from a stored increment of a thermal run (:func:`.thermal.holds.hold_trial`).
 
         Raises
@@ -64,9 +70,19 @@ class EventReplay:
         FileFormatError
             If the run is athermal (``temperature = 0``) or the increment is not stored.
         """
-        if self.params.temperature <= 0.0:
-            raise FileFormatError(f"{self.path}: an athermal run (temperature = 0) has no hold trials")
-        return hold_trial(self.simulation, self._state(increment), hold_time, below, replica)
+        self._thermal()
+        return hold_trial(self.simulation, self._state(increment), hold_time, below, replica, each)
+
+    def aftershocks(self, increment, hold_time, replica, control=None):
+        """An aftershock or control hold from a stored increment of a thermal run (:func:`.thermal.aftershocks.aftershock_trial`).
+
+        Raises
+        ------
+        FileFormatError
+            If the run is athermal (``temperature = 0``) or the increment is not stored.
+        """
+        self._thermal()
+        return aftershock_trial(self.simulation, self._state(increment), hold_time, replica, control)
 
     def failures(self, increment):
         """Redo one kick increment and record every well hop of the interface blocks.

@@ -67,7 +67,8 @@ class Format:
     describe : str or None
         ``"module:function"``: ``function(path) -> dict`` of the database's simulation
         columns (``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
-        ``phi``, ``regime``, ``seed``, ``temperature``, ``attempt_rate``, ``drive_rate``) read from one file.
+        ``phi``, ``regime``, ``seed``, ``temperature``, ``attempt_rate``, ``drive_rate``, ``junction_strengthening``,
+        ``junction_glass_temperature``, ``junction_attempt_rate``) read from one file.
     unstamped : int or None
         The version a file without ``format`` attributes is read as (its layout is
         documented for other writers, e.g. lab scripts; the reader validates the

@@ -361,12 +361,18 @@ def describe(path):
     dict[str, object]
         ``n`` (interfaces), ``plates``, ``blocks`` (N), ``k_drive``, ``phi``, ``regime``, ``seed``:
         the file's own header; ``temperature`` (a thermal producer's attribute; 0 for a file without it,
-        the athermal protocol), and for a thermal run ``attempt_rate`` and ``drive_rate`` (None otherwise).
+        the athermal protocol), for a thermal run ``attempt_rate`` and ``drive_rate`` (None otherwise) and
+        ``junction_strengthening`` (0 without junction aging), and with aging ``junction_glass_temperature``
+        and ``junction_attempt_rate`` (None otherwise).
     """
     attrs = read_run_attrs(path)
     thermal = attrs.get("protocol") == "thermal"
+    aging = "junction_strengthening" in attrs
     return {"n": int(attrs["n_interfaces"]), "plates": int(attrs["plates"]), "blocks": int(attrs["N"]),
             "k_drive": float(attrs["k_drive"]), "phi": float(attrs["phi"]), "regime": str(attrs["regime"]),
             "seed": int(attrs["seed"]), "temperature": float(attrs["temperature"]) if thermal else 0.0,
             "attempt_rate": float(attrs["attempt_rate"]) if thermal else None,
-            "drive_rate": float(attrs["drive_rate"]) if thermal else None}
+            "drive_rate": float(attrs["drive_rate"]) if thermal else None,
+            "junction_strengthening": float(attrs["junction_strengthening"]) if aging else 0.0 if thermal else None,
+            **{name: float(attrs[name]) if aging else None
+               for name in ("junction_glass_temperature", "junction_attempt_rate")}}

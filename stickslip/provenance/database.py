@@ -32,8 +32,9 @@ __all__ = ["SCHEMA_VERSION", "Base", "SchemaInfo", "Run", "ArtifactRow", "Simula
 #: rebuild``). 2: ``simulations.phi``; 3: lineage (``artifacts.format``, ``artifacts.made_by``,
 #: ``simulations.format``), ``slip_events`` is the ``event-table`` file's table as it is;
 #: 4: ``run_periodicity`` and the view ``periodicity_full``; 5: ``simulations.temperature``,
-#: ``attempt_rate``, ``drive_rate`` (thermal fem runs).
-SCHEMA_VERSION = 5
+#: ``attempt_rate``, ``drive_rate`` (thermal fem runs); 6: ``simulations.junction_strengthening``,
+#: ``junction_glass_temperature``, ``junction_attempt_rate`` (fem runs with junction aging).
+SCHEMA_VERSION = 6
 
 
 class Base(DeclarativeBase):
@@ -116,6 +117,13 @@ class Simulation(Base):
                                                                 "protocol) [G eps0^2 h^2]")
     attempt_rate: Mapped[float | None] = mapped_column(Float, doc="attempt rate of a thermal fem run [1/time]")
     drive_rate: Mapped[float | None] = mapped_column(Float, doc="drive rate of a thermal fem run [eps0/time]")
+    junction_strengthening: Mapped[float | None] = mapped_column(
+        Float, doc="junction aging of a thermal fem run: widening of a well per unit junction depth (0: no aging) "
+                   "[eps0 / (G eps0^2 h^2)]")
+    junction_glass_temperature: Mapped[float | None] = mapped_column(
+        Float, doc="scale T_g of the junction depths of a fem run with aging [G eps0^2 h^2]")
+    junction_attempt_rate: Mapped[float | None] = mapped_column(
+        Float, doc="attempt rate of the junction redraws of a fem run with aging [1/time]")
 
 
 class SlipEvent(Base):
@@ -181,7 +189,8 @@ Index("ix_slip_events_sim_interface", SlipEvent.simulation_run_id, SlipEvent.int
 VIEWS = {
     "slip_events_full": (
         "SELECT e.*, s.protocol, s.n, s.a, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed, s.temperature, "
-        "s.attempt_rate, s.drive_rate FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
+        "s.attempt_rate, s.drive_rate, s.junction_strengthening, s.junction_glass_temperature, s.junction_attempt_rate "
+        "FROM slip_events AS e LEFT JOIN simulations AS s ON s.run_id = e.simulation_run_id"),
     "periodicity_full": (
         "SELECT p.*, s.solver, s.n, s.plates, s.blocks, s.k_drive, s.phi, s.regime, s.seed, "
         "json_extract(r.params, '$.dt_scale') AS dt_scale FROM run_periodicity AS p "

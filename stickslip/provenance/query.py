@@ -111,7 +111,8 @@ def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=No
     pandas.DataFrame
         One row per run: the ``runs`` columns, then ``solver``, ``source``,
         ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``regime``, ``temperature``,
-        ``attempt_rate``, ``drive_rate`` (NULL for runs that are not simulations); ordered by kind, plugin, run id.
+        ``attempt_rate``, ``drive_rate``, ``junction_strengthening``, ``junction_glass_temperature``,
+        ``junction_attempt_rate`` (NULL for runs that are not simulations); ordered by kind, plugin, run id.
 
     Notes
     -----
@@ -119,7 +120,8 @@ def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=No
     """
     columns = [Simulation.solver, Simulation.source, Simulation.protocol, Simulation.n, Simulation.a,
                Simulation.plates, Simulation.blocks, Simulation.k_drive, Simulation.phi, Simulation.regime,
-               Simulation.temperature, Simulation.attempt_rate, Simulation.drive_rate]
+               Simulation.temperature, Simulation.attempt_rate, Simulation.drive_rate, Simulation.junction_strengthening,
+               Simulation.junction_glass_temperature, Simulation.junction_attempt_rate]
     statement = (select(Run, *columns).outerjoin(Simulation, Simulation.run_id == Run.run_id)
                  .order_by(Run.kind, Run.plugin, Run.run_id))
     statement = _where(statement, [(Run.kind, kind), (Run.plugin, plugin), (Simulation.solver, solver),

@@ -10,13 +10,20 @@ hold (delayed failure). The trial records the peak stress of the slipping interf
 the load increment before the slip), the creep during the hold (the interface's slip in well hops),
 and every block's forward barrier
 at the start and at the end of the hold (the state at rest after the last hop within it).
+
+With ``each > 0`` the trial goes on after the first slip until every interface has slipped ``each``
+times, and records every slip: its interface, peak, time, and the share of the interface's blocks
+that changed well (Gauss point 0) between the end of the hold (or the interface's previous slip) and
+the load before the slip (the precursors; with junction aging, the blocks whose junction the
+precursors renewed), so that a second slip tells whether the first one erased the memory of the hold. With junction aging the
+trial also records the junctions of every interface at the end of the hold.
 """
 
 import numpy as np
 
 from ..observables import Observer
-from .barriers import FORWARD, block_barriers
 from .aging import thermal_protocol
+from .barriers import FORWARD, block_barriers
 from .protocol import STREAM, drive_scale
 
 __all__ = ["hold_trial", "MAX_EVENTS", "REPLICAS"]
@@ -41,7 +48,19 @@ def _slips(observer):
     return observer.well_index().sum(axis=1).astype(np.float64)
 
 
-def hold_trial(simulation, state, hold_time, below, replica):
+def _junctions(stack, a, N):
+    """Mean depth [G eps0^2 h^2], mean widening [eps0] and capped share of the junctions of interface ``a`` (NaN: none)."""
+    junctions = stack.junctions
+    mine = slice((a - 1) * N, a * N)
+    if junctions is None or not np.any(junctions.well[mine] >= 0):
+        return [np.nan] * 3
+    widening, capped = junctions.widenings(stack.wells)
+    whole = junctions.well[mine] >= 0
+    return [junctions.depth[mine][whole].mean(), widening[mine][whole].mean() / junctions.eps0,
+            capped[mine][whole].mean()]
+
+
+def hold_trial(simulation, state, hold_time, below, replica, each=0):
     """One hold trial from a stored state (module docstring).
 
     Parameters
@@ -56,6 +75,8 @@ def hold_trial(simulation, state, hold_time, below, replica):
         Imposed shear between the hold's load and the athermal threshold [eps0] (>= 0).
     replica : int
         Index of the trial's random stream (trials with the same index draw the same numbers).
+    each : int, optional
+        0: the trial ends at the first slip; ``k > 0``: once every interface has slipped ``k`` times.
 
     Returns
     -------
@@ -67,7 +88,9 @@ def hold_trial(simulation, state, hold_time, below, replica):
         slip of every interface since then in well hops of its blocks (Gauss point 0), after each of the
         ``k`` hops within the hold);
         ``barriers_start``, ``barriers_end`` (float64 [ni]: forward barrier of every block /
-        temperature, at the start and the end of the hold).
+        temperature, at the start and the end of the hold); ``slips`` (float64 [m, 7]: interface, peak
+        [sig0], time since the hold's start, precursor share, and the interface's junctions at the peak,
+        :func:`_junctions` (NaN without aging), of every slip of an interface in order).
     """
     s, p = simulation, simulation.params
     s.stack.restore(*state)
@@ -85,14 +108,17 @@ def hold_trial(simulation, state, hold_time, below, replica):
     r0 = _slips(observer)
     barriers_start = barriers_end = _barriers(s, unit)
     previous = observer.well_index()
-    creep = []
+    hold_end = previous.copy()
+    creep, slips = [], []
+    counts = np.zeros(p.plates, dtype=np.int64)
     result = {"t0": t0, "peak": np.nan, "interface": 0, "mu_start": np.nan, "failed_in_hold": False,
               "t_slip": np.nan, "hold_hops": 0}
     for k in range(1, MAX_EVENTS + 1):
         protocol.step(False, p.margin, 2 * k - 1)
         load = observer.observe(previous)
         t = s.stack.time - t0
-        previous = observer.well_index()
+        previous = load_wells = observer.well_index()
+        at_peak = [_junctions(s.stack, a, p.N) for a in interfaces]
         protocol.step(True, p.margin, 2 * k)
         event = observer.observe(previous)
         previous = observer.well_index()
@@ -101,12 +127,20 @@ def hold_trial(simulation, state, hold_time, below, replica):
             creep.append([t, *(_slips(observer) - r0)])
             barriers_end = _barriers(s, unit)
         slipping = [a for a in interfaces if event[f"A_a{a}"] == p.N]
-        if slipping:
+        for a in slipping:
+            counts[a] += 1
+            slips.append([a, load[names[a - 1]], t, np.mean(load_wells[a - 1] != hold_end[a - 1]), *at_peak[a - 1]])
+            hold_end[a - 1] = previous[a - 1]
+        if slipping and np.isnan(result["peak"]):
             a = slipping[0]
             result.update(peak=load[names[a - 1]], interface=a, mu_start=start[names[a - 1]],
                           failed_in_hold=bool(t < hold_time), t_slip=t)
+        if slipping and np.all(counts[1:] >= each):
             break
+        if t < hold_time:
+            hold_end = previous.copy()
     result["events"] = k
     result["creep"] = np.asarray(creep, dtype=np.float64).reshape(-1, p.plates)
     result["barriers_start"], result["barriers_end"] = barriers_start, barriers_end
+    result["slips"] = np.asarray(slips, dtype=np.float64).reshape(-1, 7)
     return result

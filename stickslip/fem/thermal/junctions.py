@@ -140,7 +140,7 @@ class Junctions:
         float64 [ni] its depth [G eps0^2 h^2] (0 without a junction).
     scale : float
         Widening per unit depth ``lambda eps0`` [strain].
-    glass_temperature, attempt_rate : float
+    glass_temperature, attempt_rate, eps0 : float
     """
 
     def __init__(self, ni, strengthening, glass_temperature, attempt_rate, eps0):
@@ -149,6 +149,7 @@ class Junctions:
         self.scale = float(strengthening) * float(eps0)
         self.glass_temperature = float(glass_temperature)
         self.attempt_rate = float(attempt_rate)
+        self.eps0 = float(eps0)
 
     def aged(self, wells):
         """The held yield strains widened by the junctions: a new float64 [ni, ny] array.
