@@ -34,7 +34,7 @@ from stickslip.fem.simulation import Simulation
 from stickslip.fem.thermal.junctions import CAP, renew, widen
 from stickslip.fem.thermal.redraws import REDRAW, sample_with_redraws
 from stickslip.fem.thermal.sampler import NONE, THRESHOLD
-from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
+from stickslip.formats.fem_run import RunFile, describe, read_increments, read_run_attrs
 from stickslip.h5io import write_attrs
 from stickslip.params import ParameterError, parse_params
 from stickslip.registry import get, run_id
@@ -222,6 +222,9 @@ def test_aging_off_gives_the_thermal_run_of_before_bit_for_bit(tmp_path):
     plugin = get("solver", "fem")
     assert run_id(plugin, _params(**THERMAL, junction_strengthening=0.0)) == run_id(plugin, _params(**THERMAL))
     assert "junction_strengthening" not in read_run_attrs(plain)["params"]
+    # the database's columns: no aging in a thermal run, none at all in an athermal one
+    described = describe(plain)
+    assert described["junction_strengthening"] == 0.0 and described["junction_glass_temperature"] is None
 
 
 @pytest.fixture(scope="module")
@@ -275,6 +278,9 @@ def test_an_aging_run_redraws_its_junctions_and_states_its_parameters(aging_run)
     attrs = read_run_attrs(aging_run)
     assert (attrs["junction_strengthening"], attrs["junction_glass_temperature"], attrs["junction_attempt_rate"]) == \
         (5.0, 8e-3, 1.0)
+    described = describe(aging_run)  # the database's typed columns
+    assert (described["junction_strengthening"], described["junction_glass_temperature"],
+            described["junction_attempt_rate"]) == (5.0, 8e-3, 1.0)
     table = read_increments(aging_run)
     loads = table[~table["kick"]]
     assert loads["redraws"].sum() > 100  # junctions redrawn at rest

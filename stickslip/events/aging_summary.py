@@ -56,8 +56,9 @@ def load_aging_runs(paths):
     Returns
     -------
     pandas.DataFrame
-        ``file``, ``n``, ``seed``, ``temperature``, ``drive_rate``, ``strengthening`` (0 without aging),
-        ``T0`` and ``data`` (:class:`.results.AnalysisFile`); only thermal runs.
+        ``file``, ``trials`` (the analysis's ``hold_interfaces``: the runs it made trials in; a study may
+        analyse its runs with several parameterisations), ``n``, ``seed``, ``temperature``, ``drive_rate``, ``strengthening`` (0 without aging), ``T0`` and
+        ``data`` (:class:`.results.AnalysisFile`); only thermal runs.
     """
     rows = []
     for path in sorted(map(str, paths)):
@@ -66,12 +67,13 @@ def load_aging_runs(paths):
         item = read_analysis_file(path, "event-table", present)
         if not item.attrs.get("thermal", False):
             continue
-        rows.append({"file": path, "n": item.n, "seed": int(item.attrs["seed"]),
+        rows.append({"file": path, "trials": int(item.attrs["analysis_params"].get("hold_interfaces", 1)),
+                     "n": item.n, "seed": int(item.attrs["seed"]),
                      "temperature": float(item.attrs["temperature"]), "drive_rate": float(item.attrs["drive_rate"]),
                      "strengthening": float(item.attrs.get("junction_strengthening", 0.0)),
                      "T0": float(item.attrs["T0"]), "data": item})
-    return pd.DataFrame(rows, columns=["file", "n", "seed", "temperature", "drive_rate", "strengthening", "T0",
-                                       "data"])
+    return pd.DataFrame(rows, columns=["file", "trials", "n", "seed", "temperature", "drive_rate", "strengthening",
+                                       "T0", "data"])
 
 
 def first_peaks(item, slip=1):

@@ -21,7 +21,7 @@ from .protocol import STREAM
 __all__ = ["aftershock_trial", "MAX_HOLD_EVENTS"]
 
 #: Events after which a hold is cut short (its ``complete`` is then False).
-MAX_HOLD_EVENTS = 1000
+MAX_HOLD_EVENTS = 300
 
 
 class _Unload:
