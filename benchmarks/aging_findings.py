@@ -27,24 +27,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from stickslip.events.aging_summary import (aftershock_pairs, curvature, driven_aftershocks, estimator, first_peaks,
-                                            load_aging_runs, mean_sem, paired_slopes, ratio, rate_slope)
+from stickslip.events.aging_summary import (aftershock_pairs, curvature, driven_aftershocks, estimator, load_aging_runs,
+                                            mean_sem, paired_slopes, rate_slope, ratio, select_runs, trial_peaks)
 from stickslip.experiment.aging import spread_of_aging_rate
 from stickslip.formats.fem_run import read_increments
 
 BASE = {"n": 1, "temperature": 1e-3, "drive_rate": 2e-8, "strengthening": 5.0}
-
-
-def select(runs, **where):
-    chosen = np.ones(len(runs), dtype=bool)
-    for key, value in where.items():
-        chosen &= np.isclose(runs[key].to_numpy(dtype=float), value, rtol=1e-9, atol=0)
-    return runs[chosen]
-
-
-def peaks_of(runs, slip=1):
-    parts = [first_peaks(item, slip).assign(run=k) for k, item in enumerate(runs["data"])]
-    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
 
 
 def fmt(value, error, digits=4):
@@ -72,14 +60,14 @@ def holds_summary(runs):
                 "T 2e-3": {**BASE, "temperature": 2e-3}, "aging off": {**BASE, "strengthening": 0.0}}
     slopes = {}
     for name, where in settings.items():
-        peaks = peaks_of(select(runs, **where))
+        peaks = trial_peaks(select_runs(runs, **where))
         if peaks.empty:
             continue
         peaks = peaks[np.isclose(peaks["below"], 0.02)]
         slope, error, states = paired_slopes(peaks)
         widening = paired_slopes(peaks, "widening")
         bend, bend_error = curvature(peaks)
-        second = paired_slopes(peaks_of(select(runs, **where), slip=2).query("below == 0.02"))
+        second = paired_slopes(trial_peaks(select_runs(runs, **where), slip=2).query("below == 0.02"))
         failed = peaks.drop_duplicates(["run", "state", "hold_time"])["failed_in_hold"].mean()
         slopes[name] = (slope, error, widening)
         lam, T = where["strengthening"], where["temperature"]
@@ -94,11 +82,11 @@ def holds_summary(runs):
         if base and name in slopes:
             print(f"- {name} / base: {fmt(*ratio(slopes[name][0], slopes[name][1], base[0], base[1]), 2)} "
                   f"(the mechanism: 2)")
-    table, slope, error = rate_slope(select(runs, n=1, temperature=1e-3, strengthening=5.0))
+    table, slope, error = rate_slope(select_runs(runs, n=1, temperature=1e-3, strengthening=5.0))
     print("- steady-state peak against the drive rate (aging on): "
           + ", ".join(f"{row.drive_rate:g}: {fmt(row.peak, row.sem, 3)} ({row.slips})" for row in table.itertuples())
           + f"; slope {fmt(slope, error)} sig0 per e-fold of rate (negative: velocity weakening, a - b < 0)")
-    off = select(runs, n=1, temperature=1e-3, strengthening=0.0, drive_rate=2e-8)
+    off = select_runs(runs, n=1, temperature=1e-3, strengthening=0.0, drive_rate=2e-8)
     if len(off):
         peaks = np.concatenate([item.tables["slip_events"]["mu_before"].to_numpy() for item in off["data"]])
         print(f"- aging off at 2e-8: steady-state peak {fmt(*mean_sem(peaks)[:2], 3)} ({len(peaks)} slips)")
@@ -106,7 +94,7 @@ def holds_summary(runs):
 
 def loads_summary(runs):
     print("\n## Aging against the hold load (base runs)")
-    peaks = peaks_of(select(runs, **BASE))
+    peaks = trial_peaks(select_runs(runs, **BASE))
     if peaks.empty:
         return
     for below, part in peaks.groupby("below"):
@@ -124,14 +112,14 @@ def estimator_summary(runs, every):
     for strengthening in (5.0, 0.0):
         pooled = []
         for n in (1, 2, 3):
-            chosen = select(runs, n=n, temperature=1e-3, drive_rate=2e-8, strengthening=strengthening)
+            chosen = select_runs(runs, n=n, temperature=1e-3, drive_rate=2e-8, strengthening=strengthening)
             if chosen.empty:
                 continue
             slips = pd.concat([item.tables["slip_events"].assign(seed=seed) for item, seed in
                                zip(chosen["data"], chosen["seed"])], ignore_index=True)
             pooled.append(slips.rename(columns={"interface": "a"}).assign(n=n, protocol="stack"))
             T0 = float(chosen["T0"].iloc[0])
-            peaks = peaks_of(select(every[every["trials"] == n], n=n, temperature=1e-3, drive_rate=2e-8,
+            peaks = trial_peaks(select_runs(every[every["trials"] == n], n=n, temperature=1e-3, drive_rate=2e-8,
                                     strengthening=strengthening))
             peaks = peaks[np.isclose(peaks["below"], 0.02)] if not peaks.empty else peaks
             for a in range(1, n + 1):

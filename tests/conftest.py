@@ -3,13 +3,17 @@
 import json
 import os
 import shutil
+import signal
+import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import pytest
 
 from stickslip import registry
+from stickslip.formats.fem_run import read_run_attrs
 from stickslip.lineage import Artifact
 from stickslip.study import Study
 
@@ -208,3 +212,19 @@ def drawn_figures(monkeypatch):
 
     monkeypatch.setattr(Figure, "savefig", recording_savefig)
     return drawn
+
+
+def kill_run_at(command, path, stop):
+    """Start ``command`` (a ``stickslip simulate`` writing ``path``) and kill it (SIGKILL) once ``path`` stores
+    ``stop`` increments (or let it end)."""
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
+    while process.poll() is None:
+        try:
+            stored = read_run_attrs(path)["nstored"]
+        except Exception:
+            stored = 0
+        if stored >= stop:
+            process.send_signal(signal.SIGKILL)
+            break
+        time.sleep(0.05)
+    process.communicate()

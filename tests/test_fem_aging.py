@@ -17,16 +17,15 @@
 import hashlib
 import math
 import os
-import signal
 import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np
 import pytest
 from scipy import stats
 
+from conftest import kill_run_at
 from stickslip.fem.backends import make_backend
 from stickslip.fem.laws import Cusp
 from stickslip.fem.random import pcg32_seed
@@ -310,17 +309,7 @@ def test_same_seed_same_bytes_and_a_cut_or_killed_aging_run_resumes_to_them(tmp_
     params = [arg for key, value in {**CASE, **AGING, "max_increments": 120}.items()
               for arg in ("--param", f"{key}={','.join(map(str, value)) if isinstance(value, tuple) else value}")]
     command = [sys.executable, "-m", "stickslip", "simulate", "--solver", "fem", *params, "-o", str(killed)]
-    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
-    while process.poll() is None:
-        try:
-            stored = read_run_attrs(killed)["nstored"]
-        except Exception:
-            stored = 0
-        if stored >= 40:
-            process.send_signal(signal.SIGKILL)
-            break
-        time.sleep(0.05)
-    process.communicate()
+    kill_run_at(command, killed, 40)
     done = subprocess.run(command, capture_output=True, text=True, env=os.environ)
     assert done.returncode == 0, done.stderr
     assert killed.read_bytes() == first.read_bytes()

@@ -62,7 +62,34 @@ def test_a_producer_with_other_parameters_writes_a_readable_file(tmp_path):
             run.state(3)
     assert formats.describe("fem-run", path) == {"n": 1, "plates": 2, "blocks": 9, "k_drive": 0.5, "phi": 5e-7,
                                                   "regime": "compliant", "seed": 3, "temperature": 0.0,
-                                                  "attempt_rate": None, "drive_rate": None}  # an athermal producer
+                                                  "attempt_rate": None, "drive_rate": None,
+                                                  "junction_strengthening": None, "junction_glass_temperature": None,
+                                                  "junction_attempt_rate": None}  # an athermal producer
+
+
+def test_a_producer_stores_further_state_per_increment_and_reads_it_back(tmp_path):
+    mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+    ndof, nlayer, ni = mesh.ndof, mesh.nlayer, mesh.interface_elements.size
+    response = (np.zeros(ndof), np.zeros((ni, 4, 3)), np.zeros(nlayer), 0.5)
+    fields = {"depth": ((ni,), np.float64), "well": ((ni,), np.int64)}
+    path = tmp_path / "further.h5"
+    with open_file(path, "w") as file:
+        fem_run.create_file(file, HEADER, mesh, response, ["t"], state_fields=fields)
+        for i in range(3):
+            further = {"depth": np.full(ni, 0.5 * i), "well": np.arange(ni) + i}
+            fem_run.append_increment(file, (np.zeros(ndof), np.zeros(nlayer), 0.0, 0.1 * i, further),
+                                     {"increment": i, "kick": False, "yield_element": False, "t": 0.1 * i})
+    with open_file(path) as file:
+        state = fem_run.RunFile(file).state(2)
+        assert len(state) == 5 and state[4]["well"].dtype == np.int64
+        np.testing.assert_array_equal(state[4]["depth"], np.full(ni, 1.0))
+        np.testing.assert_array_equal(state[4]["well"], np.arange(ni) + 2)
+        assert file["state/depth"].chunks == (1, ni)
+    # a file without further state gives the four items it always gave
+    _write(tmp_path / "plain.h5")
+    with open_file(tmp_path / "plain.h5") as file:
+        assert len(fem_run.RunFile(file).state(1)) == 4 and sorted(file["state"]) == ["lever_target", "t", "target",
+                                                                                        "u"]
 
 
 def test_rows_beyond_nstored_are_dropped_by_rewrite(tmp_path):

@@ -14,15 +14,14 @@ for both laws, and the hop's kick carries every Gauss point of the block over th
 
 import math
 import os
-import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
 from scipy import special, stats
 
+from conftest import kill_run_at
 from stickslip.fem.laws import Cusp, Smooth, backward_barrier, forward_barrier
 from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.fem.random import pcg32_seed
@@ -239,17 +238,7 @@ def test_same_seed_same_bytes_and_a_killed_thermal_run_resumes_to_them(tmp_path)
               for arg in ("--param", f"{key}={','.join(map(str, value)) if isinstance(value, tuple) else value}")]
     command = [sys.executable, "-m", "stickslip", "simulate", "--solver", "fem", *params, "-o", str(killed)]
     for stop in (7, 20, 33):  # after a load increment and after an event increment, twice
-        process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
-        while process.poll() is None:
-            try:
-                stored = read_run_attrs(killed)["nstored"]
-            except Exception:
-                stored = 0
-            if stored >= stop:
-                process.send_signal(signal.SIGKILL)
-                break
-            time.sleep(0.05)
-        process.communicate()
+        kill_run_at(command, killed, stop)
     done = subprocess.run(command, capture_output=True, text=True, env=os.environ)
     assert done.returncode == 0, done.stderr
     assert killed.read_bytes() == first.read_bytes()

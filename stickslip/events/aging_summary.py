@@ -33,7 +33,7 @@ from ..formats.analysis_file import open_analysis_file
 from .omori import bootstrap_omori
 from .results import read_analysis_file
 
-__all__ = ["TABLES", "load_aging_runs", "first_peaks", "paired_slopes", "curvature", "ratio", "rate_slope",
+__all__ = ["TABLES", "load_aging_runs", "select_runs", "first_peaks", "trial_peaks", "paired_slopes", "curvature", "ratio", "rate_slope",
            "estimator", "aftershock_pairs", "driven_aftershocks", "mean_sem"]
 
 #: Tables of a ``thermal-events`` output that the summary reads (those absent are empty).
@@ -74,6 +74,20 @@ def load_aging_runs(paths):
                      "T0": float(item.attrs["T0"]), "data": item})
     return pd.DataFrame(rows, columns=["file", "trials", "n", "seed", "temperature", "drive_rate", "strengthening",
                                        "T0", "data"])
+
+
+def select_runs(runs, **where):
+    """The rows of :func:`load_aging_runs` whose columns equal the given values (floats to 1e-9 relative)."""
+    chosen = np.ones(len(runs), dtype=bool)
+    for key, value in where.items():
+        chosen &= np.isclose(runs[key].to_numpy(dtype=float), value, rtol=1e-9, atol=0)
+    return runs[chosen]
+
+
+def trial_peaks(runs, slip=1):
+    """:func:`first_peaks` of several runs, with a column ``run`` (the row's position) keeping their states apart."""
+    parts = [first_peaks(item, slip).assign(run=k) for k, item in enumerate(runs["data"])]
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
 
 
 def first_peaks(item, slip=1):

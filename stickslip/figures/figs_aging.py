@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from .. import registry
-from ..events.aging_summary import estimator, first_peaks, load_aging_runs, mean_sem, paired_slopes
+from ..events.aging_summary import estimator, load_aging_runs, mean_sem, paired_slopes, select_runs, trial_peaks
 from ..experiment.aging import log_binned
 from ..h5io import FileFormatError
 from ..params import param
@@ -50,18 +50,6 @@ class FigsAgingParams:
     strengthening: float = param(5.0, "junction_strengthening of the base runs", unit="eps0 / (G eps0^2 h^2)",
                                  exclusive_minimum=0.0)
     below: float = param(0.02, "hold load of panels (a)-(c)", unit="eps0", minimum=0.0)
-
-
-def _select(runs, **where):
-    chosen = np.ones(len(runs), dtype=bool)
-    for key, value in where.items():
-        chosen &= np.isclose(runs[key].to_numpy(dtype=float), value, rtol=1e-9, atol=0)
-    return runs[chosen]
-
-
-def _peaks(runs, slip=1):
-    parts = [first_peaks(item, slip).assign(run=k) for k, item in enumerate(runs["data"])]
-    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
 
 
 def centred(peaks, column="peak"):
@@ -94,7 +82,7 @@ def _legend(ax, size):
 
 
 def _base(runs, params):
-    return _select(runs, n=1, drive_rate=params.drive_rate, temperature=params.temperature,
+    return select_runs(runs, n=1, drive_rate=params.drive_rate, temperature=params.temperature,
                    strengthening=params.strengthening)
 
 
@@ -111,12 +99,12 @@ def draw(params, inputs):
                 ("T x 2", dict(temperature=2 * params.temperature, strengthening=params.strengthening), "C2"),
                 ("no aging", dict(temperature=params.temperature, strengthening=0.0), "0.4")]
     for label, where, color in settings:
-        peaks = _peaks(_select(runs, **at, **where))
+        peaks = trial_peaks(select_runs(runs, **at, **where))
         peaks = peaks[np.isclose(peaks["below"], params.below)] if not peaks.empty else peaks
         _holds_panel(ax[0], peaks, label, {"color": color, "marker": "o"})
-    base = _peaks(_base(runs, params))
+    base = trial_peaks(_base(runs, params))
     base_below = base[np.isclose(base["below"], params.below)] if not base.empty else base
-    second = _peaks(_base(runs, params), slip=2)
+    second = trial_peaks(_base(runs, params), slip=2)
     second = second[np.isclose(second["below"], params.below)] if not second.empty else second
     _holds_panel(ax[1], base_below, "first slip", {"color": "C0", "marker": "o"})
     _holds_panel(ax[1], second, "second slip", {"color": "C3", "marker": "s"})
@@ -145,7 +133,7 @@ def draw(params, inputs):
     ax[3].set_ylabel(r"$B$ of the paired holds [$\sigma_0$ per e-fold]")
     ax[3].set_title("aging against the hold load", fontsize=8)
     for strengthening, color in ((params.strengthening, "C0"), (0.0, "0.4")):
-        chosen = _select(runs, n=1, temperature=params.temperature, strengthening=strengthening)
+        chosen = select_runs(runs, n=1, temperature=params.temperature, strengthening=strengthening)
         for rate, group in chosen.groupby("drive_rate"):
             peaks = np.concatenate([item.tables["slip_events"]["mu_before"].to_numpy() for item in group["data"]])
             mean, sem, _ = mean_sem(peaks)
@@ -156,7 +144,7 @@ def draw(params, inputs):
     ax[4].set_ylabel(r"steady-state peak [$\sigma_0$]")
     _legend(ax[4], 6)
     for n in (1, 2, 3):
-        chosen = _select(runs, n=n, drive_rate=params.drive_rate, temperature=params.temperature,
+        chosen = select_runs(runs, n=n, drive_rate=params.drive_rate, temperature=params.temperature,
                          strengthening=params.strengthening)
         if chosen.empty:
             continue
