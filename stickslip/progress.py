@@ -23,12 +23,13 @@ import os
 import sys
 import warnings
 
-from tqdm import TqdmExperimentalWarning, tqdm
+from tqdm import TqdmWarning, tqdm
 
-# tqdm's widget bar in a Jupyter kernel (where ipywidgets is installed), its terminal bar elsewhere; without
-# tqdm.auto's notice "notebook mode" and its import of asyncio (30 ms).
+# tqdm's widget bar in a Jupyter kernel where ipywidgets is installed, its terminal bar elsewhere (which a
+# notebook redraws in place too); without tqdm's notices ("notebook mode", "IProgress not found") and
+# tqdm.auto's import of asyncio (30 ms).
 with warnings.catch_warnings():
-    warnings.simplefilter("ignore", TqdmExperimentalWarning)
+    warnings.simplefilter("ignore", TqdmWarning)
     from tqdm.autonotebook import tqdm as notebook_tqdm
 
 __all__ = ["INTERVAL_VARIABLE", "DEFAULT_LOG_INTERVAL", "log_interval", "bar", "iterate"]
