@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..experiment.aging import FITS, fit_aging, fit_aging_per_interface
+from ..experiment.aging import FITS, fit_single_slips
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
 from ..experiment.plausibility import no_slip_warning, travel_warning
 from ..experiment.timeseries import read_timeseries
@@ -70,15 +70,14 @@ def run(args):
         write_text_output(args.output, slips.to_csv(index=False), overwrite=args.overwrite)
         print(f"{len(slips)} slips ({int(slips['multi'].sum())} in multi-interface events) -> {args.output}")
     if args.aging:
-        single = slips[~slips["multi"].to_numpy(dtype=bool)]
         print(f"aging fit ({args.fit}) on the single slips in logarithmic bins of T (T0 = {params.t0} s)")
         if args.per_interface:
-            for a, fit in fit_aging_per_interface(single, t0=params.t0, fit=args.fit).items():
+            for a, fit in fit_single_slips(slips, t0=params.t0, fit=args.fit, per_interface=True).items():
                 print(f"a={a} " + (_fit_line(fit, intercept=True) if not isinstance(fit, ValueError)
                                    else f"no fit: {fit}"))
         else:
             try:
-                fit = fit_aging(single["T"], single["dmu"], t0=params.t0, fit=args.fit)
+                fit = fit_single_slips(slips, t0=params.t0, fit=args.fit)
             except ValueError as error:
                 hint = "; the records are implausible for their apparatus (warnings above)" if warnings else ""
                 raise ParameterError(f"{error}{hint}") from None

@@ -3,11 +3,8 @@
 import argparse
 from pathlib import Path
 
-from .. import registry
-from ..numba_options import set_num_threads
-from ..output_safety.atomic import check_output
-from ..output_safety.overwrite import claimed_output
-from ..params import params_to_dict, parse_assignments, parse_params
+from ..params import parse_assignments
+from ..simulation import run_solver
 from . import add_overwrite_option
 
 
@@ -28,7 +25,6 @@ def add_parser(subparsers):
     parser.set_defaults(func=run)
 
 
-
 def positive_int(text):
     """An argparse type: an integer >= 1."""
     try:
@@ -40,18 +36,8 @@ def positive_int(text):
     return value
 
 
-def run_identity(plugin, params):
-    """What a solver's output file stores about its run (root attributes): format, solver, version, parameters."""
-    return {"format": plugin.produces, "solver": plugin.name, "solver_version": plugin.version,
-            "params": params_to_dict(params)}
-
-
 def run(args):
-    """Validate the parameters and the output, then run the solver."""
-    plugin = registry.get("solver", args.solver)
-    params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
-    threads = set_num_threads(args.threads)
-    check_output(args.output)
-    with claimed_output(args.output, run_identity(plugin, params), overwrite=args.overwrite):
-        plugin.run(params, args.output, threads=threads, inputs={})
+    """Validate the parameters and the output, then run the solver (:func:`stickslip.simulation.run_solver`)."""
+    run_solver(args.solver, args.output, parse_assignments(args.param), threads=args.threads,
+               overwrite=args.overwrite)
     return 0

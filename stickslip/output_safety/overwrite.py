@@ -207,7 +207,7 @@ def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe
 
 
 @contextmanager
-def claimed_output(path, identity, *, overwrite=False):
+def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
     """The one rule of the command line: write ``path`` in the block only if it is absent, this run, or ``overwrite``.
 
     Before the block: an absent output or one that holds this run (:func:`refuse_other_run`) is
@@ -224,6 +224,8 @@ def claimed_output(path, identity, *, overwrite=False):
         Root attributes of the file this run writes (see the module docstring).
     overwrite : bool, optional
         Replace another run (``--overwrite``).
+    hint : str, optional
+        The end of the refusal's message: how to overwrite (default: the command line's ``--overwrite``).
 
     Raises
     ------
@@ -236,7 +238,7 @@ def claimed_output(path, identity, *, overwrite=False):
         print(f"stickslip: {path}: not a readable HDF5 file; moved it to {aside}, starting the run over",
               file=sys.stderr)
     try:
-        refuse_other_run(path, identity)
+        refuse_other_run(path, identity, hint=hint)
     except OutputExistsError as error:
         if not overwrite:
             raise
