@@ -64,10 +64,10 @@ def simulate(solver, output, *, threads=1, overwrite=False, **params):
     stickslip.output_safety.errors.OutputError
         An ``OSError``: the output cannot be written, or holds another run and ``overwrite`` is false.
     """
-    # Imported here: stickslip.simulation imports numba, and numba imported with the package would fix its
+    # Imported here: stickslip.solver_run imports numba, and numba imported with the package would fix its
     # thread pool and cache directory before a workflow job sets them (workflow_api.prepare_environment;
     # every job imports this package first).
-    from .simulation import run_solver
+    from .solver_run import run_solver
 
     run_solver(solver, output, params, threads=threads, overwrite=overwrite, overwrite_hint=OVERWRITE_HINT)
     return open_run(output)

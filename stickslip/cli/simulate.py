@@ -4,7 +4,7 @@ import argparse
 from pathlib import Path
 
 from ..params import parse_assignments
-from ..simulation import run_solver
+from ..solver_run import run_solver
 from . import add_overwrite_option
 
 
@@ -37,7 +37,7 @@ def positive_int(text):
 
 
 def run(args):
-    """Validate the parameters and the output, then run the solver (:func:`stickslip.simulation.run_solver`)."""
+    """Validate the parameters and the output, then run the solver (:func:`stickslip.solver_run.run_solver`)."""
     run_solver(args.solver, args.output, parse_assignments(args.param), threads=args.threads,
                overwrite=args.overwrite)
     return 0

@@ -94,10 +94,11 @@ class EventReplay:
         FileFormatError
             If the increment is not stored.
         """
-        self.system.restore(*self._state(increment))
-        state = self.system.state
-        return {"eps": state.eps.reshape(-1, self.N, 4, 3).copy(), "sig": state.sig.reshape(-1, self.N, 4, 3).copy(),
-                "well": self.system.well_index().reshape(-1, self.N, 4)}
+        stack = self.simulation.stack
+        stack.restore(*self._state(increment))
+        eps, sig = stack.backend.read("eps", "sig")
+        return {"eps": eps.reshape(-1, self.N, 4, 3).copy(), "sig": sig.reshape(-1, self.N, 4, 3).copy(),
+                "well": stack.well_index().reshape(-1, self.N, 4)}
 
     def failures(self, increment):
         """Redo one kick increment and record every well hop of the interface blocks.
