@@ -25,6 +25,9 @@ changed well, all interfaces), and last
 ``steps_ratio=<dynamic/exact, all> small_steps_ratio=<dynamic/exact, A < 10>
 time_ratio=<dynamic (assembled) / exact (structured) wall time>``.
 
+``--exact-only`` with ``--event``: the exact relaxation alone (to compare two versions of its
+solve: run them alternately, each its own process).
+
 ``--linear-response``: the direct solve of the linear response (factorisation included);
 last line ``linear_response_s=<value>``.
 
@@ -161,38 +164,41 @@ def _per_step(args, mesh, threads):
 
 
 def _events(system, count):
-    """Run ``count`` events; returns arrays (steps, seconds, A) per event."""
-    steps, seconds, sizes = [], [], []
+    """Run ``count`` events; returns arrays (steps, seconds, A, CPU seconds of this process) per event."""
+    steps, seconds, sizes, cpu = [], [], [], []
     dt = system.model.dt
     for _ in range(count):
         system.event_step(kick=False)
         before = system.state.idx[:, 0].copy()
         t0 = system.state.t[0]
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         converged, _ = system.kick(system.params.margin)
         seconds.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - cpu_start)
         if not converged:
             raise SystemExit("a block reached the end of its yield strains: use fewer --events or a larger --nchunk")
         steps.append(int(round((system.state.t[0] - t0) / dt)))
         sizes.append(int(np.count_nonzero(system.state.idx[:, 0] != before)))
-    return np.array(steps), np.array(seconds), np.array(sizes)
+    return np.array(steps), np.array(seconds), np.array(sizes), np.array(cpu)
 
 
-def _summary(name, steps, seconds, sizes):
+def _summary(name, steps, seconds, sizes, cpu):
     for label, keep in (("all", sizes >= 0), (f"A<{SMALL}", sizes < SMALL), (f"A>={SMALL}", sizes >= SMALL)):
         if not keep.any():
             print(f"{name:8s} {label:6s} events=0")
             continue
         print(f"{name:8s} {label:6s} events={keep.sum():4d} steps_total={steps[keep].sum():10d} "
               f"steps_median={np.median(steps[keep]):9.0f} seconds_per_event={seconds[keep].mean():.4f} "
-              f"seconds_median={np.median(seconds[keep]):.4f}")
+              f"seconds_median={np.median(seconds[keep]):.4f} cpu_per_event={cpu[keep].mean():.4f} "
+              f"cpu_median={np.median(cpu[keep]):.4f}")
 
 
 def _event_mode(args, mesh, threads):
     _compile_kernels()
     runs = {}
     response = None
-    for relaxation, backend in (("dynamic", "assembled"), ("exact", "structured")):
+    relaxations = (("dynamic", "assembled"), ("exact", "structured"))
+    for relaxation, backend in relaxations[1:] if args.exact_only else relaxations:
         params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, nchunk=args.nchunk, seed=args.seed,
                            relaxation=relaxation, backend=backend)
         system = System(params, mesh, make_backend(backend, threads))
@@ -206,6 +212,8 @@ def _event_mode(args, mesh, threads):
         _ = system.equilibrium  # factorise outside the timing (once per run)
         runs[relaxation] = _events(system, args.events)
         _summary(relaxation, *runs[relaxation])
+    if args.exact_only:
+        return
     dyn, fast = runs["dynamic"], runs["exact"]
     same = int(np.argmin(dyn[2] == fast[2])) if not np.array_equal(dyn[2], fast[2]) else args.events
     print(f"event sizes A equal for the first {same} of {args.events} events")
@@ -242,6 +250,8 @@ def main(argv=None):
     parser.add_argument("--threads", type=int, default=1)
     parser.add_argument("--steps", type=int, default=2000, help="time steps to time (per-step mode)")
     parser.add_argument("--event", action="store_true", help="consecutive events with both relaxations")
+    parser.add_argument("--exact-only", action="store_true",
+                        help="--event with the exact relaxation only (to compare versions of it)")
     parser.add_argument("--events", type=int, default=100, help="number of events (--event)")
     parser.add_argument("--k_drive", type=float, default=1e-3, help="drive stiffness per unit volume (--event)")
     parser.add_argument("--seed", type=int, default=0, help="realisation (--event)")
