@@ -1,10 +1,10 @@
-"""The fixed-order dense algebra of the exact relaxation (:mod:`stickslip.fem.fixed_order`) against numpy."""
+"""The fixed-order dense algebra (:mod:`stickslip.fixed_order`) against numpy."""
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from stickslip.fem.fixed_order import columns_dot_dense, inverse, matmul, woodbury_correct
+from stickslip.fixed_order import columns_dot_dense, dot, inverse, matmul, solve, woodbury_correct
 
 
 def test_products_and_inverse_equal_numpy_to_round_off():
@@ -15,6 +15,12 @@ def test_products_and_inverse_equal_numpy_to_round_off():
     square[[0, 3]] = square[[3, 0]]  # a small leading pivot: needs the row exchange
     square[0, 0] = 1e-12
     np.testing.assert_allclose(inverse(square) @ square, np.eye(6), rtol=0, atol=1e-12)
+    vector = rng.standard_normal(6)
+    np.testing.assert_allclose(solve(square, vector), np.linalg.solve(square, vector), rtol=1e-12)
+    batch = rng.standard_normal((2, 3, 4))
+    np.testing.assert_allclose(dot(batch, b), batch @ b, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(dot(a, b[:, 0]), a @ b[:, 0], rtol=0, atol=1e-14)
+    assert dot(b[:, 0], b[:, 0]) == pytest.approx(b[:, 0] @ b[:, 0], rel=1e-15)
     with pytest.raises(ValueError, match="singular"):
         inverse(np.zeros((2, 2)))
 

@@ -24,7 +24,7 @@ QDLDL (the ``qdldl`` package: ``P`` SuiteSparse's approximate minimum degree ord
 arithmetic only; the factorisation and the triangular solves plain serial C loops, with no BLAS);
 the drive is added by the Woodbury identity (``A^-1 b = y - Z (I + M U^T Z)^-1 M U^T y``,
 ``y = (K_p + K_i)^-1 b``, ``Z = (K_p + K_i)^-1 U``), its small dense products and inverse in a
-fixed order (:mod:`.fixed_order`). Nothing here depends on the CPU's BLAS kernel: the solve gives
+fixed order (:mod:`stickslip.fixed_order`). Nothing here depends on the CPU's BLAS kernel: the solve gives
 the same bits on every x86-64 host (``benchmarks/host_bytes.py`` compares them under every OpenBLAS
 kernel a host supports; SuperLU, used before, calls the BLAS and did not). For an all-elastic model (the linear response) ``A`` is
 the exact stiffness and one iteration is the solution.
@@ -45,7 +45,7 @@ import qdldl
 import scipy.sparse as sp
 
 from .assembly import assemble_csr, elastic_element_stiffness
-from .fixed_order import columns_dot_dense, inverse, matmul, woodbury_correct
+from ..fixed_order import columns_dot_dense, inverse, matmul, woodbury_correct
 
 __all__ = ["WellEquilibrium", "MAX_NEWTON", "STALL"]
 

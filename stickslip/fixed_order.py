@@ -1,12 +1,15 @@
 """Small dense linear algebra in a fixed order of operations, with no BLAS.
 
-numpy's ``@`` and :func:`numpy.linalg.inv` call the BLAS and LAPACK that numpy was built
-with (OpenBLAS), which picks a kernel for the CPU at run time (SkylakeX on AVX-512, Haswell on
-AVX2 and Zen): the same product sums in another order, and its last bits differ from host to
-host. The exact relaxation's drive correction (:mod:`.equilibrium`, the Woodbury identity) is
-computed here instead, with plain loops whose order is fixed in the source; numba's ``fastmath``
-stays off (:mod:`stickslip.numba_options`), so LLVM neither reorders nor fuses them, and the
-result is the same bit for bit on every x86-64 host.
+numpy's ``@``, :func:`numpy.linalg.solve` and :func:`numpy.linalg.inv` call the BLAS and LAPACK
+that numpy was built with (OpenBLAS), which picks a kernel for the CPU at run time (SkylakeX on
+AVX-512, Haswell on AVX2 and Zen, SandyBridge...): the same product sums in another order, and its
+last bits differ from host to host (``benchmarks/host_bytes.py``). Every product and solve whose
+result reaches a solver's output is computed here instead (the exact relaxation's drive correction,
+:mod:`stickslip.fem.equilibrium`; the virtual lever's coupling matrices,
+:mod:`stickslip.experiment.virtual`), with plain loops whose order is fixed in the source; numba's
+``fastmath`` stays off (:mod:`stickslip.numba_options`), so LLVM neither reorders nor fuses them, and
+the result is the same bit for bit on every x86-64 host. The matrices are small (a few rows) or
+the products sparse: the loops cost no more than the BLAS call.
 
 The drive's layer weights ``U`` [n, m] are passed as columns of a sparse matrix: ``ptr``
 int64 [m + 1], and for column ``l`` the rows ``rows[ptr[l]:ptr[l + 1]]`` with the weights
@@ -15,9 +18,35 @@ int64 [m + 1], and for column ``l`` the rows ``rows[ptr[l]:ptr[l + 1]]`` with th
 
 import numpy as np
 
-from ..numba_options import njit
+from .numba_options import njit
 
-__all__ = ["matmul", "inverse", "columns_dot", "columns_dot_dense", "woodbury_correct"]
+__all__ = ["dot", "solve", "matmul", "inverse", "columns_dot", "columns_dot_dense", "woodbury_correct"]
+
+
+def dot(a, b):
+    """``a @ b`` (:func:`matmul`) for ``a`` [..., k] or [k] and ``b`` [k, m] or [k], with numpy's shapes.
+
+    Parameters
+    ----------
+    a, b : array_like
+        float64.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The shape of ``a @ b`` (a float for two vectors).
+    """
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    left = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
+    right = np.ascontiguousarray(b.reshape(b.shape[0], -1))
+    out = matmul(left, right)
+    shape = a.shape[:-1] + b.shape[1:]
+    return float(out[0, 0]) if not shape else out.reshape(shape)
+
+
+def solve(a, b):
+    """``a^-1 b`` for a small non-singular ``a`` [n, n] and ``b`` [n], by :func:`inverse` then :func:`dot`."""
+    return dot(inverse(np.ascontiguousarray(a, dtype=np.float64)), b)
 
 
 @njit
