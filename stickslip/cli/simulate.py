@@ -1,9 +1,11 @@
 """``stickslip simulate``: run one solver on parameters given as KEY=VALUE."""
 
 import argparse
+import os
 from pathlib import Path
 
 from .. import registry
+from ..arithmetic import CONTINUE_VARIABLE
 from ..numba_options import set_num_threads
 from ..output_safety.atomic import check_output
 from ..output_safety.overwrite import claimed_output
@@ -25,6 +27,10 @@ def add_parser(subparsers):
                         help="output file (HDF5); an existing one of the same run is resumed (fem) or written "
                              "again, one of another run is refused")
     add_overwrite_option(parser)
+    parser.add_argument("--resume-other-arithmetic", action="store_true",
+                        help="resume a run although the packages that decide its bits (numpy, scipy, numba, "
+                             "llvmlite, qdldl, h5py, Python, libm) differ from those it was started with; the file "
+                             f"records from which increment (also: {CONTINUE_VARIABLE}=1)")
     parser.set_defaults(func=run)
 
 
@@ -52,6 +58,8 @@ def run(args):
     params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
     threads = set_num_threads(args.threads)
     check_output(args.output)
+    if args.resume_other_arithmetic:
+        os.environ[CONTINUE_VARIABLE] = "1"
     with claimed_output(args.output, run_identity(plugin, params), overwrite=args.overwrite):
         plugin.run(params, args.output, threads=threads, inputs={})
     return 0

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
-from ..formats.fem_run import RunFile, append_increment, create_file, rewrite
+from ..formats.fem_run import RunFile, append_increment, check_arithmetic, create_file, rewrite
 from ..h5io import FileFormatError, UnreadableFileError, open_file, read_table
 from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
@@ -174,7 +174,7 @@ def run_simulation(params, output, mesh, backend, *, producer):
         if completed is None:
             _create(output, params, mesh, backend, producer)
         else:
-            rewrite(output)
+            rewrite(output, **check_arithmetic(output))
         new, reason = _increments(params, output, backend)
         rewrite(output, completed=True, stop_reason=reason)
         return new
