@@ -57,7 +57,7 @@ def test_a_completed_fem_run_is_not_replaced_by_any_writer(fem_run, tmp_path, ca
     target = tmp_path / "run.h5"
     target.write_bytes(fem_run.read_bytes())
     err = refused(capsys, LEVER + ["-o", str(target)], target)
-    assert "holds a fem-run file of solver fem 3 (this run: format 'timeseries')" in err
+    assert "holds a fem-run file of solver fem 4 (this run: format 'timeseries')" in err
     refused(capsys, RATE_STATE + ["-o", str(target)], target)
     refused(capsys, ["import-csv", *csv_files(tmp_path), "-o", str(target)], target)
     refused(capsys, ["mesh", "-o", str(target)], target)
@@ -72,7 +72,7 @@ def test_each_solver_refuses_another_run_passes_its_own_and_overwrites_when_aske
     made = sha256(target)
     assert main(LEVER + ["-o", str(target)]) == 0 and sha256(target) == made  # the same run again
     err = refused(capsys, LEVER + ["--param", "seed=3", "-o", str(target)], target)
-    assert "holds a timeseries file of solver lever 1 with other parameters: seed = 0 (this run: 3)" in err
+    assert "holds a timeseries file of solver lever 2 with other parameters: seed = 0 (this run: 3)" in err
     err = refused(capsys, RATE_STATE + ["-o", str(target)], target)
     assert "(this run: solver 'rate-state-lever')" in err
     refused(capsys, FEM + ["-o", str(target)], target)

@@ -6,16 +6,18 @@ user's making (bad parameter, unknown plugin, unreadable file) are printed as on
 line ``stickslip: error: ...`` with exit status 2, never as a traceback. Every command that writes a
 file refuses an existing output that holds another run unless given ``--overwrite``. Ctrl-C and
 SIGTERM end a command cleanly (files closed, what a run stored is kept) with exit
-status 130 (SIGINT) or 143 (SIGTERM).
+status 130 (SIGINT) or 143 (SIGTERM). Warnings of the package (parameters outside the studied regime)
+are one line ``stickslip: warning: ...``.
 """
 
 import argparse
 import importlib
 import sys
+import warnings
 
 from ..h5io import FileFormatError
 from ..output_safety.errors import OutputError
-from ..params import ParameterError
+from ..params import ParameterError, ParameterWarning
 from ..registry import PluginError
 from ..termination import exit_status, interrupts_raised, interruption
 
@@ -47,8 +49,19 @@ def build_parser():
     return parser
 
 
+def _one_line_warning(message, category, filename, lineno, line=None):
+    """``warnings`` output: the package's own warnings as one line, others as Python prints them."""
+    if issubclass(category, ParameterWarning):
+        return f"stickslip: warning: {message}\n"
+    return _python_warning(message, category, filename, lineno, line)
+
+
+_python_warning = warnings.formatwarning
+
+
 def main(argv=None):
     """Run the command line; return the exit status."""
+    warnings.formatwarning = _one_line_warning
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -29,7 +29,7 @@ from ..formats.fem_run import RunFile, append_increment, check_arithmetic, creat
 from ..h5io import FileFormatError, UnreadableFileError, open_file, read_table
 from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
-from ..output_safety.overwrite import set_aside
+from ..output_safety.overwrite import changed_values, set_aside
 from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .observables import Observer, observable_columns
@@ -122,7 +122,9 @@ def _stored(output, params):
         print(f"stickslip: {error}; moved it to {aside}, starting the run over", file=sys.stderr)
         return None
     if params_to_dict(stored) != params_to_dict(params):
-        raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
+        raise FileFormatError(f"{output}: exists with other parameters: "
+                              f"{changed_values(params_to_dict(stored), params_to_dict(params))}; remove it or use "
+                              f"another output")
     return completed
 
 

@@ -42,8 +42,6 @@ _DESCRIBING = ("format", "solver", "solver_version", "analysis")
 #: How a message calls an item of the identity.
 _NAMES = {"params": "parameters"}
 
-#: Differences listed in a message at most.
-_SHOWN = 3
 
 _MISSING = object()
 
@@ -143,6 +141,23 @@ def _description(stored):
     return what
 
 
+def changed_values(stored, wanted):
+    """Every entry of two mappings that differs, as ``name = stored (this run: wanted)``, comma-separated.
+
+    Parameters
+    ----------
+    stored, wanted : Mapping[str, object]
+        E.g. a file's parameters and this run's (an entry absent from one shows as "(none)").
+
+    Returns
+    -------
+    str
+    """
+    changed = [name for name in {**stored, **wanted} if stored.get(name, _MISSING) != wanted.get(name, _MISSING)]
+    return ", ".join(f"{name} = {_show(stored.get(name, _MISSING))} (this run: {_show(wanted.get(name, _MISSING))})"
+                     for name in changed)
+
+
 def _difference(stored, identity, describe):
     """What ``stored`` holds against ``identity``, or None if it is the same run."""
     for key, expected in identity.items():
@@ -151,10 +166,7 @@ def _difference(stored, identity, describe):
             continue
         what = describe(stored)
         if isinstance(expected, dict) and isinstance(value, dict):
-            changed = [name for name in {**value, **expected} if value.get(name, _MISSING) != expected.get(name)]
-            listed = ", ".join(f"{name} = {_show(value.get(name, _MISSING))} (this run: "
-                               f"{_show(expected.get(name, _MISSING))})" for name in changed[:_SHOWN])
-            return f"holds {what} with other {_NAMES.get(key, key)}: {listed}{', ...' if len(changed) > _SHOWN else ''}"
+            return f"holds {what} with other {_NAMES.get(key, key)}: {changed_values(value, expected)}"
         if key in _DESCRIBING:
             return f"holds {what} (this run: {key} {_show(expected)})"
         return f"holds {what} with {key} = {_show(value)} (this run: {_show(expected)})"
