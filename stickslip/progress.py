@@ -116,8 +116,8 @@ def bar(total=None, *, desc, unit="it", initial=0, postfix=None, stream=None):
         Call ``update(amount)`` as work is done.
     """
     stream = sys.stderr if stream is None else stream
-    if _is_terminal(stream):
-        return tqdm(total=total, desc=desc, unit=unit, initial=initial, postfix=postfix, file=stream,
+    if _is_terminal(stream):  # the unit after a space: "149 increment", "2.30 increment/s"
+        return tqdm(total=total, desc=desc, unit=f" {unit}", initial=initial, postfix=postfix, file=stream,
                     dynamic_ncols=True)
     interval = log_interval()
     # miniters=1: every update checks the clock, so the interval holds however the rate changes.

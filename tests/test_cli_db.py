@@ -145,3 +145,13 @@ def test_db_sql_stops_at_ctrl_c_within_a_second(toy_results):
         process.wait()
         pytest.fail("db sql went on for 10 s after Ctrl-C")
     assert time.monotonic() - start < 1.5 and process.returncode == 130
+
+
+def test_a_mistyped_regime_is_refused_not_answered_with_no_rows(toy_results, capsys):
+    assert _run("db", "rebuild")[0] == 0
+    capsys.readouterr()
+    for command in ("events", "runs"):
+        with pytest.raises(SystemExit) as exited:
+            _run("db", command, "--regime", "complaint")
+        assert exited.value.code == 2
+        assert "invalid choice: 'complaint' (choose from 'stiff', 'compliant')" in capsys.readouterr().err

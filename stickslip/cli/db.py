@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..formats.fem_run import REGIMES
 from ..h5io import FileFormatError
 from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
 
@@ -60,7 +61,7 @@ def add_parser(subparsers):
     runs.add_argument("--plugin")
     runs.add_argument("--solver")
     runs.add_argument("--n", type=int, help="number of driven interfaces")
-    runs.add_argument("--regime")
+    runs.add_argument("--regime", choices=REGIMES)
     runs.add_argument("--seed", type=int)
     runs.set_defaults(func=run_runs)
 
@@ -71,7 +72,7 @@ def add_parser(subparsers):
     events.add_argument("--source", choices=("numerical", "experimental"))
     events.add_argument("--n", type=int, help="number of driven interfaces")
     events.add_argument("--interface", type=int, help="interface (slab) a, 1 = lowest")
-    events.add_argument("--regime")
+    events.add_argument("--regime", choices=REGIMES)
     events.add_argument("--seed", type=int)
     events.add_argument("--run-id", help="one simulation")
     events.set_defaults(func=run_events)

@@ -15,8 +15,10 @@ file too damaged to open (a truncated copy) is moved aside, never deleted (:func
 """
 
 import errno
+import glob
 import json
 import os
+import re
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -26,6 +28,7 @@ import numpy as np
 from ..h5io import FileFormatError, open_file
 from .atomic import atomic_output
 from .errors import OutputError
+from .lock import writer_lock
 
 __all__ = ["OutputExistsError", "refuse_other_run", "claimed_output", "write_text_output", "set_aside",
            "OVERWRITE_HINT"]
@@ -225,9 +228,11 @@ def claimed_output(path, identity, *, overwrite=False):
     Before the block: an absent output or one that holds this run (:func:`refuse_other_run`) is
     left to the writer (to write, resume or leave); an HDF5 file too damaged to open is moved
     aside to ``<name>.unreadable`` (with a message); another run is refused, unless ``overwrite``:
-    it is then moved aside to ``<name>.replaced`` until the block ends. If the block fails before
-    it has written ``path``, the replaced file is moved back; if it fails after, the replaced
-    file stays aside (the message says where); if it succeeds, the replaced file is deleted.
+    it is then moved aside to ``<name>.replaced`` until the block ends (never while another process
+    writes it: that is refused first). If the block fails before it has written ``path``, the
+    replaced file is moved back; if it fails after, the replaced file stays aside (the message says
+    where); if it succeeds, the replaced file is deleted, and so is one left aside by an earlier
+    ``--overwrite`` whose new run was interrupted and has now been completed (with a message).
 
     Parameters
     ----------
@@ -252,7 +257,8 @@ def claimed_output(path, identity, *, overwrite=False):
     except OutputExistsError as error:
         if not overwrite:
             raise
-        replaced = set_aside(path, "replaced")
+        with writer_lock(path):  # another process writing it: refused before anything is moved
+            replaced = set_aside(path, "replaced")
         print(f"stickslip: {path}: {error.difference}; --overwrite: moved it to {replaced} until the new output "
               f"is complete", file=sys.stderr)
     else:
@@ -268,6 +274,16 @@ def claimed_output(path, identity, *, overwrite=False):
         raise
     if replaced is not None:
         replaced.unlink()
+    for earlier in _replaced_earlier(path):
+        earlier.unlink()
+        print(f"stickslip: {path} is complete: removed {earlier}, the run it replaced (an earlier --overwrite)",
+              file=sys.stderr)
+
+
+def _replaced_earlier(path):
+    """Files that an earlier ``--overwrite`` of ``path`` set aside (``<name>.replaced[-<k>]``)."""
+    pattern = re.compile(re.escape(path.name) + r"\.replaced(-\d+)?")
+    return sorted(p for p in path.parent.glob(glob.escape(path.name) + ".replaced*") if pattern.fullmatch(p.name))
 
 
 def write_text_output(path, text, *, overwrite=False):
