@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/host_bytes.py                      # every case, every setting this host supports
     python benchmarks/host_bytes.py --case fem-exact     # one case
+    python benchmarks/host_bytes.py --case fem-default-study --setting machine --setting avx2-host
 
 Each case is one ``stickslip simulate`` run (a fresh process, its own output file) under each
 setting of what a host chooses by its CPU, set here and nowhere else (tests and CI keep the
@@ -47,6 +48,9 @@ CASES = {
     "fem-dynamic": ("fem", ["N=9", "plates=2", "max_increments=20"]),
     "fem-thermal": ("fem", ["N=9", "plates=2", "relaxation=exact", "max_increments=30", "temperature=0.05",
                             "drive_rate=1e-6"]),
+    # one fem run of the default study (workflow/config/default.yaml), minutes per setting
+    "fem-default-study": ("fem", ["N=162", "plates=3", "relaxation=exact", "dt_scale=4", "max_increments=250",
+                                  "k_drive=0.08281", "seed=1"]),
     "lever": ("lever", ["n=3", "duration=600"]),
     "rate-state-lever": ("rate-state-lever", ["n=3", "duration=300"]),
 }
@@ -131,7 +135,9 @@ def sha256(path):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--case", choices=sorted(CASES), action="append", help="case to run (repeat; default all)")
+    parser.add_argument("--case", choices=sorted(CASES), action="append",
+                        help="case to run (repeat; default all but fem-default-study)")
+    parser.add_argument("--setting", action="append", help="setting to run, by its printed name (repeat; default all)")
     args = parser.parse_args(argv)
     flags = cpu_flags()
     model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
@@ -139,10 +145,12 @@ def main(argv=None):
     print(f"cpu: {model}; avx512f={'avx512f' in flags} avx2={'avx2' in flags} fma={'fma' in flags}")
     all_equal = numbers_equal = True
     with tempfile.TemporaryDirectory() as tmp:
-        for case in args.case or list(CASES):
+        for case in args.case or [name for name in CASES if name != "fem-default-study"]:
             solver, assignments = CASES[case]
             reference = None
             for name, environment in settings(flags):
+                if args.setting and name not in args.setting:
+                    continue
                 output = Path(tmp) / f"{case}-{len(list(Path(tmp).iterdir()))}.h5"
                 kernels = run_case(solver, assignments, environment, output)
                 digest = sha256(output)
