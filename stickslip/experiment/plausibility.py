@@ -51,6 +51,11 @@ _FORCE_MISTAKES = (("times in ms (not s)", 1e-3), ("times in min (not s)", 60.0)
                    ("force in kN (not N)", 1e-3), ("force in mN (not N)", 1e3), ("V in m/s (not mm/s)", 1e3),
                    ("V in um/s (not mm/s)", 1e-3))
 
+#: Unit mistakes of one file's times, by the factor they multiply the force record's span over the positions' with.
+_SPAN_MISTAKES = (("times in ms (not s) in the force file", 1e3), ("times in ms (not s) in the positions file", 1e-3),
+                  ("times in min (not s) in the force file", 1 / 60.0),
+                  ("times in min (not s) in the positions file", 60.0))
+
 #: Windows over which the force's slopes are taken.
 _WINDOWS = 200
 
@@ -161,11 +166,8 @@ def missing_drop_error(record, slips, source):
         return None
     span_F, span_x = record.t_F[-1] - record.t_F[0], record.t_x[-1] - record.t_x[0]
     ratio = span_F / span_x if span_x > 0 else float("nan")
-    likely = (_likely(ratio, (("times in ms (not s) in the force file", 1e3), ("times in ms (not s) in the "
-                                                                               "positions file", 1e-3),
-                              ("times in min (not s) in the force file", 1 / 60.0),
-                              ("times in min (not s) in the positions file", 60.0)))
-              if np.isfinite(ratio) and not 1 / FACTOR <= ratio <= FACTOR else "check the two files' times")
+    likely = (_likely(ratio, _SPAN_MISTAKES) if np.isfinite(ratio) and not 1 / FACTOR <= ratio <= FACTOR
+              else "check the two files' times")
     return (f"{source}: {missing} of {len(slips)} slips have no measured force drop: the force record spans "
             f"{record.t_F[0]:.4g} ... {record.t_F[-1]:.4g} s, the positions {record.t_x[0]:.4g} ... "
             f"{record.t_x[-1]:.4g} s; {likely}")
