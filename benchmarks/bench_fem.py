@@ -28,6 +28,9 @@ time_ratio=<dynamic (assembled) / exact (structured) wall time>``.
 ``--exact-only`` with ``--event``: the exact relaxation alone (to compare two versions of its
 solve: run them alternately, each its own process).
 
+``--solve``: the exact relaxation's factorisation and one solve ``A^-1 b`` alone (random ``b``, 300
+solves, CPU time of this process); last line ``solve_cpu_us=<value>``.
+
 ``--linear-response``: the direct solve of the linear response (factorisation included);
 last line ``linear_response_s=<value>``.
 
@@ -234,6 +237,23 @@ def _compile_kernels():
             _events(warm, 3)
 
 
+def _solve_mode(args, mesh, threads):
+    system = System(FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, relaxation="exact"), mesh,
+                    make_backend("structured", threads))
+    start = time.process_time()
+    equilibrium = system.equilibrium
+    factorised = time.process_time() - start
+    b = np.random.default_rng(0).standard_normal(equilibrium.free.size)
+    equilibrium.solve(b)  # warm-up (compiles if not cached)
+    repeat = 300
+    start = time.process_time()
+    for _ in range(repeat):
+        equilibrium.solve(b)
+    per_solve = (time.process_time() - start) / repeat * 1e6
+    print(f"free_dofs={equilibrium.free.size} factorisation_cpu_s={factorised:.3f}")
+    print(f"solve_cpu_us={per_solve:.1f}")
+
+
 def _linear_response_mode(args, mesh, threads):
     _compile_kernels()
     system = System(FemParams(N=args.N, plates=args.plates, nchunk=args.nchunk, relaxation="exact"), mesh,
@@ -257,6 +277,7 @@ def main(argv=None):
     parser.add_argument("--seed", type=int, default=0, help="realisation (--event)")
     parser.add_argument("--nchunk", type=int, default=1000, help="yield strains per block (--event)")
     parser.add_argument("--linear-response", action="store_true", help="time the direct linear response")
+    parser.add_argument("--solve", action="store_true", help="time the exact relaxation's factorisation and solve")
     args = parser.parse_args(argv)
     threads = set_num_threads(args.threads)
     mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
@@ -265,6 +286,8 @@ def main(argv=None):
         _event_mode(args, mesh, threads)
     elif args.linear_response:
         _linear_response_mode(args, mesh, threads)
+    elif args.solve:
+        _solve_mode(args, mesh, threads)
     else:
         _per_step(args, mesh, threads)
 
