@@ -26,8 +26,6 @@ import platform
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-import numba
-import numpy as np
 import threadpoolctl
 from llvmlite import binding as llvm
 from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
@@ -105,9 +103,11 @@ def host():
     blas = [{"library": info.get("internal_api"), "version": info.get("version"),
              "kernel": info.get("architecture"), "threads": info.get("num_threads")}
             for info in threadpoolctl.threadpool_info() if info.get("user_api") == "blas"]
-    target = numba.config.CPU_NAME or llvm.get_host_cpu_name()
+    # numba's own variables (read here, not through numba.config: a workflow job records this before it
+    # may import numba, stickslip.workflow_api.prepare_environment)
+    target = os.environ.get("NUMBA_CPU_NAME") or llvm.get_host_cpu_name()
     return {"cpu_model": model, "cpu_simd": [flag for flag in _SIMD if flag in flags], "blas": blas,
-            "numba_target": {"cpu_name": target, "features": numba.config.CPU_FEATURES or "host"},
+            "numba_target": {"cpu_name": target, "features": os.environ.get("NUMBA_CPU_FEATURES") or "host"},
             "numpy_simd": [name for name in __cpu_dispatch__ if __cpu_features__.get(name)]}
 
 
