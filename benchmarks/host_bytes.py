@@ -98,10 +98,15 @@ def settings(flags):
 
 
 def _datasets(path):
+    """Every dataset of an HDF5 file by name."""
     found = {}
+
+    def keep(name, item):  # returns None: visititems stops at the first other value
+        if isinstance(item, h5py.Dataset):
+            found[name] = item[()]
+
     with h5py.File(path, "r") as file:
-        file.visititems(lambda name, item: found.setdefault(name, item[()]) if isinstance(item, h5py.Dataset)
-                        else None)
+        file.visititems(keep)
     return found
 
 

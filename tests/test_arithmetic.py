@@ -34,8 +34,13 @@ def _simulate(output, *extra):
 def _content(path):
     """Every dataset and attribute of a file (an in-place edit of attributes changes the bytes, not these)."""
     found = {}
+
+    def keep(name, item):  # returns None: visititems stops at the first other value
+        if isinstance(item, h5py.Dataset):
+            found[name] = item[()]
+
     with h5py.File(path, "r") as file:
-        file.visititems(lambda name, item: found.setdefault(name, item[()]) if isinstance(item, h5py.Dataset) else None)
+        file.visititems(keep)
         attrs = {key: (value.tolist() if isinstance(value, np.ndarray) else value) for key, value in file.attrs.items()}
     return found, attrs
 
