@@ -73,9 +73,9 @@ def test_a_resume_with_other_parameters_names_every_one(tmp_path, capsys):
     assert main(base + ["--param", "temperature=1e-3", "--param", "drive_rate=2e-8", "--param", "hold_times=1e3",
                         "--param", "attempt_rate=2", "--param", "hold_delay=0.1"]) == 0
     capsys.readouterr()
-    assert main(base + ["--param", "temperature=2e-3", "--param", "drive_rate=2e-7"]) == 2
+    assert main(base + ["--param", "temperature=1.5e-3", "--param", "drive_rate=2e-7"]) == 2
     error = capsys.readouterr().err
-    for name in ("temperature = 0.001 (this run: 0.002)", "drive_rate = 2e-08 (this run: 2e-07)",
+    for name in ("temperature = 0.001 (this run: 0.0015)", "drive_rate = 2e-08 (this run: 2e-07)",
                  "attempt_rate = 2.0 (this run: 1.0)", "hold_times = [1000.0] (this run: [])",
                  "hold_delay = 0.1 (this run: 0.0)"):
         assert name in error, error
