@@ -132,9 +132,9 @@ def bar(total=None, *, desc, unit="it", initial=0, postfix=None, stream=None):
         Call ``update(amount)`` as work is done.
     """
     stream = sys.stderr if stream is None else stream
-    if _is_terminal(stream) or _is_notebook(stream):
+    if _is_terminal(stream) or _is_notebook(stream):  # the unit after a space: "149 increment", "2.30 increment/s"
         live = tqdm if _is_terminal(stream) else notebook_tqdm
-        return live(total=total, desc=desc, unit=unit, initial=initial, postfix=postfix, file=stream,
+        return live(total=total, desc=desc, unit=f" {unit}", initial=initial, postfix=postfix, file=stream,
                     dynamic_ncols=True)
     interval = log_interval()
     # miniters=1: every update checks the clock, so the interval holds however the rate changes.

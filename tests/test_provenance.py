@@ -75,6 +75,10 @@ def test_record_fields_hashes_and_atomic_write(tmp_path):
     assert record["outputs"][0]["bytes"] == 6
     assert record["wall_time_s"] >= 0 and record["peak_memory_mib"] > 10
     assert record["versions"]["numpy"] and record["versions"]["python"]
+    # the arithmetic: what decides the bits (checked at a resume) and what the host chose (recorded only)
+    assert record["arithmetic"]["decisive"]["numpy"] == record["versions"]["numpy"]
+    assert record["arithmetic"]["host"]["cpu_model"] and record["arithmetic"]["host"]["blas"][0]["kernel"]
+    assert record["versions"]["scipy"] and record["versions"]["llvmlite"] and record["versions"]["qdldl"]
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no temporary left
 
 

@@ -2,7 +2,8 @@
 
 A record implausible for the apparatus it claims (:mod:`stickslip.experiment.plausibility`: a unit
 mistake) gets a one-line warning; if no slip is found at all, the command then fails (exit 2) instead
-of writing an empty result.
+of writing an empty result, and so does a record whose slips mostly have no measured force drop (its
+force and positions cover other times: one line naming the file and the likely unit).
 """
 
 import sys
@@ -12,7 +13,7 @@ import pandas as pd
 
 from ..experiment.aging import FITS, fit_single_slips
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
-from ..experiment.plausibility import no_slip_warning, travel_warning
+from ..experiment.plausibility import force_rate_warning, missing_drop_error, no_slip_warning, travel_warning
 from ..experiment.timeseries import read_timeseries
 from ..output_safety.overwrite import write_text_output
 from ..params import ParameterError, parse_assignments, parse_params
@@ -58,7 +59,11 @@ def run(args):
         record = read_timeseries(path)
         slips, _ = analyse_record(record, params)
         tables.append(slips.assign(run=str(path)))
-        found = (travel_warning(record, str(path)), no_slip_warning(record, len(slips), str(path)))
+        missing = missing_drop_error(record, slips, str(path))
+        if missing:
+            raise ParameterError(missing)
+        found = (force_rate_warning(record, str(path)), travel_warning(record, str(path)),
+                 no_slip_warning(record, len(slips), str(path)))
         warnings += [line for line in found if line]
     for line in warnings:
         print(f"stickslip: warning: {line}", file=sys.stderr)

@@ -1,8 +1,10 @@
 """``stickslip simulate``: run one solver on parameters given as KEY=VALUE."""
 
 import argparse
+import os
 from pathlib import Path
 
+from ..arithmetic import CONTINUE_VARIABLE
 from ..params import parse_assignments
 from ..solver_run import run_solver
 from . import add_overwrite_option
@@ -22,6 +24,10 @@ def add_parser(subparsers):
                         help="output file (HDF5); an existing one of the same run is resumed (fem) or written "
                              "again, one of another run is refused")
     add_overwrite_option(parser)
+    parser.add_argument("--resume-other-arithmetic", action="store_true",
+                        help="resume a run although the packages that decide its bits (numpy, scipy, numba, "
+                             "llvmlite, qdldl, h5py, Python, libm) differ from those it was started with; the file "
+                             f"records from which increment (also: {CONTINUE_VARIABLE}=1)")
     parser.set_defaults(func=run)
 
 
@@ -38,6 +44,8 @@ def positive_int(text):
 
 def run(args):
     """Validate the parameters and the output, then run the solver (:func:`stickslip.solver_run.run_solver`)."""
+    if args.resume_other_arithmetic:
+        os.environ[CONTINUE_VARIABLE] = "1"
     run_solver(args.solver, args.output, parse_assignments(args.param), threads=args.threads,
                overwrite=args.overwrite)
     return 0
