@@ -17,6 +17,7 @@
 import hashlib
 import math
 import os
+import signal
 import subprocess
 import sys
 
@@ -25,7 +26,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from conftest import kill_run_at
+from conftest import kill_when_stored
 from stickslip.fem.backends import make_backend
 from stickslip.fem.laws import Cusp
 from stickslip.fem.random import pcg32_seed
@@ -189,9 +190,10 @@ CASE = {"N": 9, "plates": 2, "seed": 1, "k_drive": 1e-3, "relaxation": "exact", 
 THERMAL = {"temperature": 2e-3, "drive_rate": 1e-5, "attempt_rate": 1.0, "hold_times": (1e4, 1e7), "hold_delay": 0.05}
 AGING = {**THERMAL, "junction_strengthening": 5.0, "junction_glass_temperature": 8e-3, "junction_attempt_rate": 1.0}
 
-#: sha256 of the state and increment datasets of the thermal run CASE + THERMAL made by main at f068ff9, before
+#: sha256 of the state and increment datasets of the thermal run CASE + THERMAL made by main at ee6f300, before
 #: junction aging (the file itself also stores the package version, so its bytes are not compared across versions).
-THERMAL_DIGEST = "c8d356a90f1e9aabdea5f34a26b2623981d10cbe943f82283f9cb145ff2bf68b"
+#: (At f068ff9, before the BLAS-free factorisation of the exact relaxation, it was c8d356a9...)
+THERMAL_DIGEST = "189c945a84f540b4005e639c9f9e33339f675ee2dc5072d9305fd1a7a116691c"
 
 
 def _params(**params):
@@ -309,7 +311,10 @@ def test_same_seed_same_bytes_and_a_cut_or_killed_aging_run_resumes_to_them(tmp_
     params = [arg for key, value in {**CASE, **AGING, "max_increments": 120}.items()
               for arg in ("--param", f"{key}={','.join(map(str, value)) if isinstance(value, tuple) else value}")]
     command = [sys.executable, "-m", "stickslip", "simulate", "--solver", "fem", *params, "-o", str(killed)]
-    kill_run_at(command, killed, 40)
+    status, err, stored = kill_when_stored(command, killed, 40, signal.SIGKILL, timeout=300)
+    assert status == -signal.SIGKILL, err  # killed, not ended by itself
+    attrs = read_run_attrs(killed)
+    assert not attrs["completed"] and attrs["nstored"] >= stored >= 40
     done = subprocess.run(command, capture_output=True, text=True, env=os.environ)
     assert done.returncode == 0, done.stderr
     assert killed.read_bytes() == first.read_bytes()
