@@ -2,7 +2,8 @@
 
 A backend is chosen once per run (:func:`make_backend`) and prepared for its model (it then owns
 the state; :mod:`.base` is the seam every backend implements). Built in: ``structured`` (default)
-and ``assembled`` (the reference), numba CPU backends (:mod:`.cpu`). A backend whose results are
+and ``assembled`` (the reference), numba CPU backends (:mod:`.cpu`), and ``cuda`` (an NVIDIA GPU,
+:mod:`.cuda`; optional dependency numba-cuda). A backend whose results are
 bit-identical to the default's would be an execution option like ``threads``; both alternatives
 here change the round-off, so the choice is the ``backend`` parameter of ``fem`` (recorded in the
 run file and its id). A new backend: one module and :func:`register_backend` (docs/developing.md,
@@ -11,6 +12,7 @@ run file and its id). A new backend: one module and :func:`register_backend` (do
 
 from .base import CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend
 from .cpu import AssembledBackend, StructuredBackend
+from .cuda import CudaBackend
 
 __all__ = ["BACKENDS", "DEFAULT_BACKEND", "Backend", "make_backend", "register_backend", "FIELDS", "CONVERGED",
            "MARGIN", "QUIET", "MAX_ITER_REACHED"]
@@ -32,6 +34,7 @@ def register_backend(cls):
 
 register_backend(StructuredBackend)
 register_backend(AssembledBackend)
+register_backend(CudaBackend)
 
 
 def make_backend(name=DEFAULT_BACKEND, threads=1):

@@ -1,0 +1,215 @@
+"""The ``cuda`` backend without a GPU: its kernels on numba's CUDA simulator against the CPU, and compiled for the H100.
+
+numba-cuda runs kernels on its simulator with ``NUMBA_ENABLE_CUDASIM=1`` (read when numba-cuda is
+imported: every simulated check runs in a fresh Python). The simulator runs each thread as a Python
+thread, a time step of an N = 9 stack in ~0.1-0.3 s: the checks are short sequences, each against the
+``structured`` CPU backend from the same state (states within round-off, wells and statuses equal):
+the force evaluation (fixed and free lever), time steps after a kick, a minimisation stopped by each of
+its criteria (step limit, quiet window, residual, margin) with the recorded well changes, the exact
+relaxation's direct solve, a thermal increment, and a batch of three realisations whose every member
+equals the same realisation run alone, bit for bit. The simulator checks no types: every kernel is also
+compiled to PTX for sm_90 (the H100) with numba-cuda's NVVM. Skipped without numba-cuda (failed instead
+where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set, as .ci/run does); the checks that need a real GPU are in
+benchmarks/gpu/ (docs/benchmarks.md).
+"""
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def numba_cuda():
+    """numba-cuda is installed (skip, or fail where .ci/run requires it)."""
+    if importlib.util.find_spec("numba_cuda") is None:
+        reason = "numba-cuda is not installed (pip install stickslip[gpu])"
+        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
+            pytest.fail(reason)
+        pytest.skip(reason)
+
+
+def _simulated(script, timeout=1200, simulator=True):
+    """Run ``script`` in a fresh Python (on numba's CUDA simulator unless ``simulator`` is False); its last line, as
+    JSON."""
+    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1" if simulator else "0"}
+    done = subprocess.run([sys.executable, "-c", textwrap.dedent(PRELUDE) + textwrap.dedent(script)],
+                          capture_output=True, text=True, timeout=timeout, env=env)
+    assert done.returncode == 0, done.stderr[-4000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+PRELUDE = """
+    import json
+    import numpy as np
+    from stickslip.fem.backends import make_backend
+    from stickslip.fem.parameters import FemParams
+    from stickslip.fem.simulation import Simulation
+    from stickslip.mesh import MeshParams, build_stack_mesh
+
+    FIELDS = ("u", "v", "a", "f", "eps", "sig", "ubar", "target", "lever", "t")
+
+    def pair(**values):
+        values = {"N": 9, "plates": 2, "seed": 1, "k_drive": 1e-3, "dt_scale": 4.0, **values}
+        mesh = build_stack_mesh(MeshParams(N=values["N"], plates=values["plates"]))
+        cpu = Simulation(FemParams(**values), mesh, make_backend())
+        gpu = Simulation(FemParams(**values, backend="cuda"), mesh, make_backend("cuda"),
+                         response=cpu.loading.response)
+        return cpu, gpu
+
+    def compare(cpu, gpu):
+        out = {"idx": bool(np.array_equal(cpu.stack.backend.read("idx")[0], gpu.stack.backend.read("idx")[0]))}
+        for name in FIELDS:
+            a, b = cpu.stack.backend.read(name)[0], gpu.stack.backend.read(name)[0]
+            scale = float(np.abs(a).max())
+            out[name] = float(np.abs(a - b).max()) / scale if scale else float(np.abs(b).max())
+        return out
+"""
+
+#: Relative difference allowed between the device's and the CPU's arrays after a few steps: round-off of
+#: other summation orders and of fused multiply-adds, amplified by a few time steps.
+ROUND_OFF = 1e-11
+
+
+def _close(differences):
+    assert differences.pop("idx"), "the wells differ"
+    assert all(value < ROUND_OFF for value in differences.values()), differences
+
+
+def test_every_kernel_compiles_for_the_h100_and_uses_no_floating_point_atomics(numba_cuda):
+    result = _simulated("""
+    from stickslip.fem.backends.cuda.compile import ptx
+    from stickslip.fem.constants import derived_constants
+    from stickslip.fem.laws import LAWS
+    from stickslip.fem.stack import build_stack
+    out = {}
+    for law in ("cusp", "smooth"):
+        params = FemParams(N=9, plates=2, nchunk=30, interface_law=law)
+        mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+        model = build_stack(params, mesh, make_backend(), derived_constants(params, mesh)).model
+        for name, text in ptx(model).items():
+            atomics = [line for line in text.splitlines() if "atom." in line]
+            out[f"{law}:{name}"] = [".target sm_90" in text, any(".f64" in a or ".f32" in a for a in atomics)]
+    print(json.dumps(out))
+    """, simulator=False)
+    assert len(result) == 16
+    for name, (targets_sm90, float_atomics) in result.items():
+        assert targets_sm90, name
+        assert not float_atomics, name
+
+
+def test_the_force_evaluation_and_time_steps_after_a_kick_equal_the_cpu(numba_cuda):
+    result = _simulated("""
+    out = {}
+    for drive in ("fixed-lever", "free-lever"):
+        cpu, gpu = pair(plates=3, drive=drive)
+        out[f"{drive}:origin"] = compare(cpu, gpu)
+        for sim in (cpu, gpu):
+            sim.loading.step(False)
+            sim.loading.step(True)
+        out[f"{drive}:kick"] = compare(cpu, gpu)
+        for sim in (cpu, gpu):
+            sim.stack.backend.advance(6)
+        out[f"{drive}:steps"] = compare(cpu, gpu)
+        out[f"{drive}:residual"] = abs(cpu.stack.backend.residual() / gpu.stack.backend.residual() - 1)
+    print(json.dumps(out))
+    """)
+    for key, value in result.items():
+        if key.endswith("residual"):
+            assert value < ROUND_OFF
+        else:
+            _close(value)
+
+
+def test_a_minimisation_stops_as_on_the_cpu_by_each_criterion_and_records_the_same_well_changes(numba_cuda):
+    result = _simulated("""
+    from stickslip.fem.thermal.hop import shear_modes
+    out = {}
+    cpu, gpu = pair()
+    mode = shear_modes(cpu.mesh)[4]
+    for sim in (cpu, gpu):
+        sim.loading.step(False)
+        sim.loading.step(True)
+        # block 4 sheared ~10 wells ahead: it and its neighbours change wells in the first steps
+        sim.stack.backend.add_u(sim.stack.model.iface_dofs[4], 6e-3 * mode)
+    # the step limit, with the well changes of Gauss point 0 recorded
+    runs = [sim.stack.backend.minimise(1e-5, 20, 12, 0, True, 0) for sim in (cpu, gpu)]
+    out["limit"] = [runs[0][:2], runs[1][:2], bool(np.array_equal(runs[0][2], runs[1][2])), len(runs[0][2]),
+                    compare(cpu, gpu)]
+    # the quiet window: from a state at rest after a load step no well changes
+    cpu, gpu = pair()
+    for sim in (cpu, gpu):
+        sim.loading.step(False)
+    runs = [sim.stack.backend.minimise(1e-5, 50, 100, 0, False, 3)[:2] for sim in (cpu, gpu)]
+    out["quiet"] = [runs[0], runs[1], compare(cpu, gpu)]
+    # the residual criterion: at the exact equilibrium of its wells the residual is at round-off
+    cpu, gpu = pair(relaxation="exact")
+    solved = [sim.relaxation.solve_in_wells(sim.stack.backend) for sim in (cpu, gpu)]
+    runs = [sim.stack.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2] for sim in (cpu, gpu)]
+    out["converged"] = [solved, runs[0], runs[1], compare(cpu, gpu), float(gpu.stack.backend.read("v")[0].max())]
+    # the margin: a kicked point in well 1 of a margin that allows none beyond well 0
+    cpu, gpu = pair()
+    for sim in (cpu, gpu):
+        sim.loading.step(False)
+        sim.loading.step(True)
+    ny = cpu.stack.model.epsy.shape[1]
+    runs = [sim.stack.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
+    out["margin"] = [runs[0], runs[1]]
+    print(json.dumps(out))
+    """)
+    limit_cpu, limit_gpu, same_events, nevents, state = result["limit"]
+    assert limit_cpu == limit_gpu == [-1, 12] and same_events and nevents > 0
+    _close(state)
+    assert result["quiet"][0] == result["quiet"][1] == [2, 3]
+    _close(result["quiet"][2])
+    solved, converged_cpu, converged_gpu, state, speed = result["converged"]
+    assert solved == [True, True] and converged_cpu == converged_gpu == [1, 3] and speed == 0.0
+    _close(state)
+    assert result["margin"][0] == result["margin"][1] == [0, 1]
+
+
+def test_the_exact_relaxation_and_a_thermal_increment_run_through_the_device(numba_cuda):
+    result = _simulated("""
+    out = {}
+    values = {"relaxation": "exact", "quiet_steps": 4, "temperature": 2e-3, "drive_rate": 1e-5}
+    cpu, gpu = pair(**values)
+    rows = [[sim.protocol.step(increment % 2 == 0, 5, increment) for increment in (1, 2)] for sim in (cpu, gpu)]
+    out["rows"] = rows
+    out["state"] = compare(cpu, gpu)
+    out["wells"] = [bool(np.array_equal(cpu.stack.well_index(), gpu.stack.well_index()))]
+    print(json.dumps(out))
+    """)
+    assert result["rows"][0] == result["rows"][1]
+    assert result["rows"][0][0]["hop_block"] >= 0 or result["rows"][0][0]["hop_block"] == -1
+    assert result["wells"] == [True]
+    differences = result["state"]
+    assert differences.pop("idx")
+    assert all(value < 1e-9 for value in differences.values()), differences  # exact solves: tol^2 residuals
+
+
+def test_a_batch_member_equals_the_same_realisation_run_alone_bit_for_bit(numba_cuda):
+    result = _simulated("""
+    from stickslip.fem.backends.cuda import run_ensemble
+    mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+    seeds = (1, 2, 3)
+
+    def run(seed, backend, steps):
+        sim = Simulation(FemParams(N=9, plates=2, seed=seed, dt_scale=4.0, backend="cuda"), mesh, backend)
+        sim.loading.step(False)
+        sim.loading.step(True)
+        status = sim.stack.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
+        return [status] + [sim.stack.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx")]
+
+    steps = {1: 6, 2: 9, 3: 4}  # members whose minimisations end at different launches
+    alone = [run(seed, make_backend("cuda"), steps) for seed in seeds]
+    batch = run_ensemble([lambda backend, seed=seed: run(seed, backend, steps) for seed in seeds])
+    print(json.dumps({"equal": [a == b for a, b in zip(alone, batch)], "status": [a[0] for a in alone]}))
+    """)
+    assert result["status"] == [[-1, 6], [-1, 9], [-1, 4]]
+    assert result["equal"] == [True, True, True]
