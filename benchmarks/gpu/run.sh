@@ -19,7 +19,7 @@ check="$PY benchmarks/gpu/gpu_check.py"
 $check cpu-step "$OUT" > "$OUT/cpu-step.log" 2>&1 &
 $check cpu-events "$OUT" > "$OUT/cpu-events.log" 2>&1 &
 for regime in stiff compliant; do
-  for seed in 1 2 3 4 5 6; do
+  for seed in $($check seeds "$OUT"); do
     $check ensemble-cpu "$OUT" $regime $seed > "$OUT/ensemble-cpu-$regime-$seed.log" 2>&1 &
   done
 done

@@ -29,10 +29,15 @@ STEPS_PER_LAUNCH = 4096
 #: Rows of a recording slot's event buffer beyond 8 per interface element.
 EVENT_CAPACITY = 1 << 16
 
+#: Held around every kernel launch: the runs of an ensemble launch from their own threads (on a GPU this
+#: only orders the launches in the stream; numba's simulator executes a launch in the caller and is not safe
+#: for launches from two threads at once).
+LAUNCHES = threading.RLock()
+
 def threads_per_block():
-    """Threads of every block: 256 on a GPU; 32 on numba's simulator (each a Python thread). The results do not
+    """Threads of every block: 256 on a GPU; 8 on numba's simulator (each a Python thread). The results do not
     depend on it (:mod:`.layout`)."""
-    return 32 if config.ENABLE_CUDASIM else 256
+    return 8 if config.ENABLE_CUDASIM else 256
 
 
 #: Per-slot fields of the state (:data:`..base.FIELDS`: ``t`` is ``clock``), and what a checkpoint copies.
@@ -186,10 +191,11 @@ class DeviceBatch:
     def set_yield_strains(self, slot, epsy, shift):
         """Hold ``epsy`` [ni, ny] in the slot (the batch's windows are widened as needed); renumber by ``shift``."""
         ni, ny = epsy.shape
-        if ny > self.epsy.shape[2]:
-            wider = np.full((self.size, ni, ny), np.inf)
-            wider[:, :, :self.epsy.shape[2]] = self.epsy.copy_to_host()
-            self.epsy = cuda.to_device(wider)
+        with LAUNCHES:
+            if ny > self.epsy.shape[2]:
+                wider = np.full((self.size, ni, ny), np.inf)
+                wider[:, :, :self.epsy.shape[2]] = self.epsy.copy_to_host()
+                self.epsy = cuda.to_device(wider)
         row = np.full((ni, self.epsy.shape[2]), np.inf)
         row[:, :ny] = epsy
         self.epsy[slot].copy_to_device(row)
@@ -215,7 +221,8 @@ class DeviceBatch:
     # --- small launches (one block per slot) -----------------------------------------------------
 
     def _one(self, kernel, slot, blocks, *args):
-        kernel[blocks, self.block](slot, *args)
+        with LAUNCHES:
+            kernel[blocks, self.block](slot, *args)
 
     def _members(self, slots):
         return self.mesh.place(np.asarray(slots, dtype=np.int64))
@@ -257,13 +264,14 @@ class DeviceBatch:
 
     def evaluate(self, slot, update_wells):
         """Everything that follows from the slot's displacement and drive; returns its residual."""
-        with self._lock:
+        with LAUNCHES:
             self.kernels.evaluate[1, self.block](*self.arguments("evaluate", self._members([slot]), update_wells))
         return float(self.scalar[slot])
 
     def load(self, slot, step):
         """Move the slot by ``step`` along its load direction (then :meth:`evaluate`)."""
-        self.kernels.load[1, self.block](*self.arguments("load", self._members([slot]), step=step))
+        with LAUNCHES:
+            self.kernels.load[1, self.block](*self.arguments("load", self._members([slot]), step=step))
 
     def add_u(self, slot, dofs, delta):
         """``u[dofs] += delta`` of the slot (then :meth:`evaluate`)."""
@@ -277,14 +285,15 @@ class DeviceBatch:
 
     def residual(self, slot):
         """The slot's relative residual."""
-        with self._lock:
+        with LAUNCHES:
             self.kernels.residual[1, self.block](*self.arguments("residual", self._members([slot])))
         return float(self.scalar[slot])
 
     def wells_hold(self, slot):
         """True if every Gauss point of the slot lies in its held well."""
         self.flag[slot:slot + 1].copy_to_device(np.ones(1, dtype=np.int64))
-        self.kernels.wells_hold[1, self.block](*self.arguments("wells_hold", self._members([slot])))
+        with LAUNCHES:
+            self.kernels.wells_hold[1, self.block](*self.arguments("wells_hold", self._members([slot])))
         return bool(self.flag[slot])
 
     # --- minimisation ----------------------------------------------------------------------------
@@ -316,8 +325,8 @@ class DeviceBatch:
 
     def _begin(self, slot, tol, niter_tol, max_iter, margin, record, quiet):
         ni = self.mesh.host.ni
-        with self._lock:
-            self._grow("history", (self.size, self._groups_cap(), niter_tol))
+        with LAUNCHES:  # no launch uses an array while it is replaced (a grow waits for the launches in flight)
+            self._grow("history", (self.size, self._groups_cap(), max(niter_tol, 64)))
             if record:
                 self._grow("events", (self.size, EVENT_CAPACITY + 8 * ni, 3))
         self.history[slot].copy_to_device(np.full(self.history.shape[1:], np.inf))
@@ -338,7 +347,7 @@ class DeviceBatch:
     def _launch(self, slots):
         """One launch of the minimisation kernel for ``slots``; their (status, steps) afterwards."""
         G = self._groups(len(slots))
-        with self._lock:
+        with LAUNCHES:
             self.counter.copy_to_device(np.zeros(self.size, dtype=np.int32))
             self.kernels.minimise[len(slots) * G, self.block](*self.arguments("minimise", self._members(slots),
                                                                                groups=G))

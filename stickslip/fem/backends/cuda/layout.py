@@ -21,10 +21,10 @@ import numpy as np
 __all__ = ["LEAVES", "ITEMS_PER_CHUNK", "DeviceLayout", "device_layout", "fixed_sum_plan", "fixed_sum"]
 
 #: Leaves of the fixed-order sums' tree (a power of 2).
-LEAVES = 64
+LEAVES = 256
 
 #: Items per chunk of a fixed-order sum, about (a chunk is one thread's sequential sum).
-ITEMS_PER_CHUNK = 16
+ITEMS_PER_CHUNK = 4
 
 DeviceLayout = namedtuple("DeviceLayout", [
     "ndof", "ni", "nlayer",
