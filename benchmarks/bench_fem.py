@@ -25,6 +25,12 @@ changed well, all interfaces), and last
 ``steps_ratio=<dynamic/exact, all> small_steps_ratio=<dynamic/exact, A < 10>
 time_ratio=<dynamic (assembled) / exact (structured) wall time>``.
 
+``--exact-only`` with ``--event``: the exact relaxation alone (to compare two versions of its
+solve: run them alternately, each its own process).
+
+``--solve``: the exact relaxation's factorisation and one solve ``A^-1 b`` alone (random ``b``, 300
+solves, CPU time of this process); last line ``solve_cpu_us=<value>``.
+
 ``--linear-response``: the direct solve of the linear response (factorisation included);
 last line ``linear_response_s=<value>``.
 
@@ -41,6 +47,7 @@ from stickslip.fem.backends.cpu.dynamics import _correct, _predict, residual
 from stickslip.fem.backends.cpu.forces import drive_force, interface_forces
 from stickslip.fem.backends.cpu.plates import plate_force
 from stickslip.fem.constants import derived_constants
+from stickslip.fem.equilibrium import WellEquilibrium
 from stickslip.fem.event_driven import autoscale
 from stickslip.fem.linear_response import LinearResponse
 from stickslip.fem.parameters import FemParams
@@ -160,39 +167,42 @@ def _per_step(args, mesh, threads):
 
 
 def _events(sim, count):
-    """Run ``count`` events; returns arrays (steps, seconds, A) per event."""
-    steps, seconds, sizes = [], [], []
+    """Run ``count`` events; returns arrays (steps, seconds, A, CPU seconds of this process) per event."""
+    steps, seconds, sizes, cpu = [], [], [], []
     stack = sim.stack
     dt = stack.model.dt
     for _ in range(count):
         sim.loading.step(kick=False)
         before = stack.well_index()[:, 0]
         t0 = stack.time
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         converged, _ = sim.protocol.kick(sim.params.margin)
         seconds.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - cpu_start)
         if not converged:
             raise SystemExit("a block reached the end of its yield strains: use fewer --events or a larger --nchunk")
         steps.append(int(round((stack.time - t0) / dt)))
         sizes.append(int(np.count_nonzero(stack.well_index()[:, 0] != before)))
-    return np.array(steps), np.array(seconds), np.array(sizes)
+    return np.array(steps), np.array(seconds), np.array(sizes), np.array(cpu)
 
 
-def _summary(name, steps, seconds, sizes):
+def _summary(name, steps, seconds, sizes, cpu):
     for label, keep in (("all", sizes >= 0), (f"A<{SMALL}", sizes < SMALL), (f"A>={SMALL}", sizes >= SMALL)):
         if not keep.any():
             print(f"{name:8s} {label:6s} events=0")
             continue
         print(f"{name:8s} {label:6s} events={keep.sum():4d} steps_total={steps[keep].sum():10d} "
               f"steps_median={np.median(steps[keep]):9.0f} seconds_per_event={seconds[keep].mean():.4f} "
-              f"seconds_median={np.median(seconds[keep]):.4f}")
+              f"seconds_median={np.median(seconds[keep]):.4f} cpu_per_event={cpu[keep].mean():.4f} "
+              f"cpu_median={np.median(cpu[keep]):.4f}")
 
 
 def _event_mode(args, mesh, threads):
     _compile_kernels()
     runs = {}
     response = None
-    for relaxation, backend in (("dynamic", "assembled"), ("exact", "structured")):
+    relaxations = (("dynamic", "assembled"), ("exact", "structured"))
+    for relaxation, backend in relaxations[1:] if args.exact_only else relaxations:
         params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, nchunk=args.nchunk, seed=args.seed,
                            relaxation=relaxation, backend=backend)
         if response is None:
@@ -205,6 +215,8 @@ def _event_mode(args, mesh, threads):
             _ = sim.relaxation.equilibrium  # factorise outside the timing (once per run)
         runs[relaxation] = _events(sim, args.events)
         _summary(relaxation, *runs[relaxation])
+    if args.exact_only:
+        return
     dyn, fast = runs["dynamic"], runs["exact"]
     same = int(np.argmin(dyn[2] == fast[2])) if not np.array_equal(dyn[2], fast[2]) else args.events
     print(f"event sizes A equal for the first {same} of {args.events} events")
@@ -224,6 +236,23 @@ def _compile_kernels():
             _events(warm, 3)
 
 
+def _solve_mode(args, mesh, threads):
+    params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, relaxation="exact")
+    model = build_stack(params, mesh, make_backend("structured", threads), derived_constants(params, mesh)).model
+    start = time.process_time()
+    equilibrium = WellEquilibrium(model)
+    factorised = time.process_time() - start
+    b = np.random.default_rng(0).standard_normal(equilibrium.free.size)
+    equilibrium.solve(b)  # warm-up (compiles if not cached)
+    repeat = 300
+    start = time.process_time()
+    for _ in range(repeat):
+        equilibrium.solve(b)
+    per_solve = (time.process_time() - start) / repeat * 1e6
+    print(f"free_dofs={equilibrium.free.size} factorisation_cpu_s={factorised:.3f}")
+    print(f"solve_cpu_us={per_solve:.1f}")
+
+
 def _linear_response_mode(args, mesh, threads):
     _compile_kernels()
     start = time.perf_counter()
@@ -239,11 +268,14 @@ def main(argv=None):
     parser.add_argument("--threads", type=int, default=1)
     parser.add_argument("--steps", type=int, default=2000, help="time steps to time (per-step mode)")
     parser.add_argument("--event", action="store_true", help="consecutive events with both relaxations")
+    parser.add_argument("--exact-only", action="store_true",
+                        help="--event with the exact relaxation only (to compare versions of it)")
     parser.add_argument("--events", type=int, default=100, help="number of events (--event)")
     parser.add_argument("--k_drive", type=float, default=1e-3, help="drive stiffness per unit volume (--event)")
     parser.add_argument("--seed", type=int, default=0, help="realisation (--event)")
     parser.add_argument("--nchunk", type=int, default=1000, help="yield strains per block (--event)")
     parser.add_argument("--linear-response", action="store_true", help="time the direct linear response")
+    parser.add_argument("--solve", action="store_true", help="time the exact relaxation's factorisation and solve")
     args = parser.parse_args(argv)
     threads = set_num_threads(args.threads)
     mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
@@ -252,6 +284,8 @@ def main(argv=None):
         _event_mode(args, mesh, threads)
     elif args.linear_response:
         _linear_response_mode(args, mesh, threads)
+    elif args.solve:
+        _solve_mode(args, mesh, threads)
     else:
         _per_step(args, mesh, threads)
 

@@ -2,7 +2,15 @@
 
 Simulations (the paper's finite-element model and a virtual lever experiment),
 analyses of their outputs and of lab recordings, the paper's figures, and the
-provenance database of a Snakemake study. See README.md for the workflow.
+provenance database of a Snakemake study. See README.md for the workflow and
+docs/tutorial.md for this API:
+
+>>> import stickslip
+>>> run = stickslip.simulate("lever", "lab.h5", n=3, seed=1)   # doctest: +SKIP
+>>> run.slip_events()                                          # doctest: +SKIP
+
+The public surface is :data:`__all__` (:mod:`stickslip.api`); every other module stays
+importable, but is not part of it.
 """
 
 from importlib.metadata import PackageNotFoundError, version
@@ -12,4 +20,11 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
-__all__ = ["__version__"]
+# The modules stickslip.params and stickslip.study share their names with two functions of the API. Importing
+# a submodule for the first time sets the package's attribute of that name: they are imported before the API
+# binds its functions, so that stickslip.params and stickslip.study stay the functions. (Import from those
+# modules, `from stickslip.params import param`, never `from stickslip import params`.)
+from . import params as _params_module, study as _study_module  # noqa: E402, F401
+from .api import open_run, params, plugins, simulate, study  # noqa: E402
+
+__all__ = ["__version__", "simulate", "open_run", "study", "plugins", "params"]

@@ -33,6 +33,7 @@ from collections.abc import Iterable, Mapping
 
 __all__ = [
     "ParameterError",
+    "ParameterWarning",
     "param",
     "parse_params",
     "did_you_mean",
@@ -45,6 +46,10 @@ __all__ = [
 
 class ParameterError(ValueError):
     """A parameter name or value is not acceptable; the message says which and why."""
+
+
+class ParameterWarning(UserWarning):
+    """Parameters that the method represents but outside the regime where it was studied; the message says which."""
 
 
 def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, exclusive_minimum=None,
@@ -154,12 +159,18 @@ def _convert(name, value, annotation, meta):
         _check_bounds(name, converted, meta)
         return converted
     if isinstance(value, str):
-        items = [item for item in value.split(",") if item.strip()]
+        text = value.strip()
+        if text[:1] + text[-1:] in ("[]", "()"):  # the YAML and Python forms: [1e3, 1e6]
+            text = text[1:-1]
+        items = [item for item in text.split(",") if item.strip()]
     elif isinstance(value, Iterable):
         items = list(value)
     else:
         items = [value]
-    converted = tuple(_convert_scalar(name, item, kind) for item in items)
+    try:
+        converted = tuple(_convert_scalar(name, item, kind) for item in items)
+    except ParameterError as error:
+        raise ParameterError(f"{error} (a list: comma-separated, e.g. {name}=1e3,1e6 or {name}=[1e3,1e6])") from None
     for item in converted:
         _check_bounds(name, item, meta)
     return converted

@@ -6,6 +6,9 @@ analyses over many runs or events, ingest) reports through :func:`bar` or
 jitted kernel. Where the progress goes:
 
 - a terminal (the stream is a TTY): tqdm's live bar, refreshed several times a second;
+- a Jupyter notebook (the stream is the kernel's output of the cell): a live bar too, tqdm's widget
+  where ipywidgets is installed (:mod:`tqdm.autonotebook`), else the terminal's bar, which the notebook
+  redraws in place;
 - anything else (a Snakemake job's log, ``2> run.log``, a SLURM output file): one
   complete line every :func:`log_interval` seconds (default 10 s, environment
   variable ``STICKSLIP_PROGRESS_INTERVAL``) and a last line when the work ends,
@@ -18,8 +21,16 @@ adds (:meth:`tqdm.tqdm.set_postfix_str`).
 
 import os
 import sys
+import warnings
 
-from tqdm import tqdm
+from tqdm import TqdmWarning, tqdm
+
+# tqdm's widget bar in a Jupyter kernel where ipywidgets is installed, its terminal bar elsewhere (which a
+# notebook redraws in place too); without tqdm's notices ("notebook mode", "IProgress not found") and
+# tqdm.auto's import of asyncio (30 ms).
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore", TqdmWarning)
+    from tqdm.autonotebook import tqdm as notebook_tqdm
 
 __all__ = ["INTERVAL_VARIABLE", "DEFAULT_LOG_INTERVAL", "log_interval", "bar", "iterate"]
 
@@ -89,6 +100,11 @@ def _is_terminal(stream):
     return bool(isatty and isatty())
 
 
+def _is_notebook(stream):
+    """Whether ``stream`` is a Jupyter kernel's output stream (a notebook cell's stdout or stderr)."""
+    return type(stream).__module__.startswith("ipykernel.")
+
+
 def bar(total=None, *, desc, unit="it", initial=0, postfix=None, stream=None):
     """Return a progress bar for the current stream (use it as a context manager).
 
@@ -116,8 +132,9 @@ def bar(total=None, *, desc, unit="it", initial=0, postfix=None, stream=None):
         Call ``update(amount)`` as work is done.
     """
     stream = sys.stderr if stream is None else stream
-    if _is_terminal(stream):
-        return tqdm(total=total, desc=desc, unit=unit, initial=initial, postfix=postfix, file=stream,
+    if _is_terminal(stream) or _is_notebook(stream):  # the unit after a space: "149 increment", "2.30 increment/s"
+        live = tqdm if _is_terminal(stream) else notebook_tqdm
+        return live(total=total, desc=desc, unit=f" {unit}", initial=initial, postfix=postfix, file=stream,
                     dynamic_ncols=True)
     interval = log_interval()
     # miniters=1: every update checks the clock, so the interval holds however the rate changes.

@@ -43,6 +43,7 @@ from collections.abc import Callable
 from importlib.metadata import entry_points
 
 from . import formats
+from .h5io import FileFormatError
 from .hashing import short_hash
 from .params import params_to_dict
 
@@ -58,6 +59,7 @@ __all__ = [
     "run_id",
     "derived_run_id",
     "config_key",
+    "replay",
 ]
 
 KINDS = ("solver", "analysis", "figure")
@@ -286,6 +288,33 @@ def get(kind, name, module=None):
     if name not in plugins:
         raise PluginError(f"unknown {kind} {name!r}; available: {', '.join(plugins) or '(none)'}")
     return plugins[name]
+
+
+def replay(solver, path):
+    """The event replay of a file that the solver ``solver`` wrote (its ``replay`` capability).
+
+    Parameters
+    ----------
+    solver : str
+        The solver plugin that wrote the file (from the file's lineage or header).
+    path : str or os.PathLike
+
+    Returns
+    -------
+    object
+        ``solver.replay(path)``: its ``failures(increment)`` re-runs one stored event.
+
+    Raises
+    ------
+    PluginError
+        If there is no such solver.
+    stickslip.h5io.FileFormatError
+        If the solver cannot replay events; the message names the file.
+    """
+    plugin = get("solver", solver)
+    if plugin.replay is None:
+        raise FileFormatError(f"{path}: solver {plugin.name!r} that wrote it cannot replay events")
+    return plugin.replay(path)
 
 
 def run_id(plugin, params):

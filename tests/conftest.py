@@ -3,13 +3,17 @@
 import json
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import pytest
 
 from stickslip import registry
+from stickslip.formats.fem_run import read_increments
+from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
 from stickslip.study import Study
 
@@ -72,7 +76,7 @@ def numba_threads_variable():
 
 
 #: Test modules that share a costly session fixture, by the fixture: pytest-xdist runs each set in one worker.
-SHARED = {"ci_study": ("test_workflow_smoke", "test_slurm", "test_docs_queries"),
+SHARED = {"ci_study": ("test_workflow_smoke", "test_slurm", "test_docs_queries", "test_tutorial"),
           "fem_reference_run": ("test_fem_reference", "test_fem_kill")}
 
 
@@ -208,3 +212,32 @@ def drawn_figures(monkeypatch):
 
     monkeypatch.setattr(Figure, "savefig", recording_savefig)
     return drawn
+
+
+def kill_when_stored(command, watched, increments, signum, timeout=600):
+    """Start ``command``, wait until ``watched`` holds ``increments`` increments, send ``signum``.
+
+    Returns
+    -------
+    (int, str, int)
+        Exit status, standard error, increments stored when the signal was sent.
+    """
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, env={**os.environ, "NUMBA_NUM_THREADS": "1"})
+    deadline = time.monotonic() + timeout
+    stored = 0
+    while time.monotonic() < deadline and process.poll() is None:
+        try:
+            stored = len(read_increments(watched))  # the running file is readable (SWMR)
+        except FileFormatError:
+            stored = 0  # not created yet
+        if stored >= increments:
+            break
+        time.sleep(0.05)
+    assert process.poll() is None, f"the run ended before {increments} increments: {process.stderr.read()}"
+    if stored < increments:
+        process.kill()
+        process.communicate()
+        pytest.fail(f"{increments} increments not stored within {timeout} s (stored {stored})")
+    process.send_signal(signum)
+    _, err = process.communicate(timeout=120)
+    return process.returncode, err, stored

@@ -3,6 +3,10 @@
 import io
 import json
 import os
+import signal
+import subprocess
+import sys
+import time
 from contextlib import redirect_stdout
 
 import pandas as pd
@@ -101,3 +105,53 @@ def test_every_db_command_describes_itself():
         with redirect_stdout(out), pytest.raises(SystemExit):
             main(["db", command, "--help"])
         assert out.getvalue().split("\n\n")[1].strip()[0].isupper()  # the paragraph after the usage
+
+
+#: A query that never ends by itself (its rows have no end), one that counts for minutes, and one
+#: that needs gigabytes (a distinct set of 10^8 numbers).
+ENDLESS = "WITH RECURSIVE c(x) AS (SELECT 1 UNION ALL SELECT x + 1 FROM c) SELECT x FROM c"
+SLOW = "WITH RECURSIVE c(x) AS (SELECT 1 UNION ALL SELECT x + 1 FROM c WHERE x < 10000000000) SELECT COUNT(*) FROM c"
+GREEDY = ("WITH RECURSIVE c(x) AS (SELECT 1 UNION ALL SELECT x + 1 FROM c WHERE x < 100000000) "
+          "SELECT COUNT(DISTINCT x) FROM c")
+
+
+def test_db_sql_is_bounded_in_rows_time_and_memory(toy_results, capsys):
+    assert _run("db", "rebuild")[0] == 0
+    capsys.readouterr()
+    for argv, bound, option in (((ENDLESS, "--max-rows", "50000"), "more than 50000 rows", "--max-rows N"),
+                                ((SLOW, "--time-limit", "0.5"), "time limit of 0.5 s", "--time-limit SECONDS"),
+                                ((GREEDY, "--memory-limit", "16"), "memory limit of 16 MiB", "--memory-limit MIB")):
+        start = time.monotonic()
+        status, text = _run("db", "sql", *argv)
+        error = capsys.readouterr().err
+        assert status == 2 and text == "" and bound in error and option in error, error
+        assert len(error.strip().splitlines()) == 1 and time.monotonic() - start < 20
+    status, text = _run("db", "sql", "SELECT COUNT(*) AS runs FROM runs", "--format", "csv")
+    assert status == 0 and text.splitlines() == ["runs", "5"]  # bounds lifted again (SQLite's heap limit is global)
+
+
+def test_db_sql_stops_at_ctrl_c_within_a_second(toy_results):
+    assert _run("db", "rebuild")[0] == 0
+    process = subprocess.Popen([sys.executable, "-m", "stickslip", "db", "sql", SLOW, "--time-limit", "0"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(4.0)  # started, and inside SQLite (the count takes minutes)
+    assert process.poll() is None
+    process.send_signal(signal.SIGINT)
+    start = time.monotonic()
+    try:
+        process.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+        pytest.fail("db sql went on for 10 s after Ctrl-C")
+    assert time.monotonic() - start < 1.5 and process.returncode == 130
+
+
+def test_a_mistyped_regime_is_refused_not_answered_with_no_rows(toy_results, capsys):
+    assert _run("db", "rebuild")[0] == 0
+    capsys.readouterr()
+    for command in ("events", "runs"):
+        with pytest.raises(SystemExit) as exited:
+            _run("db", command, "--regime", "complaint")
+        assert exited.value.code == 2
+        assert "invalid choice: 'complaint' (choose from 'stiff', 'compliant')" in capsys.readouterr().err

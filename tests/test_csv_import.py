@@ -102,3 +102,11 @@ def test_cli(tmp_path, capsys):
     assert main(["import-csv", "--force", str(tmp_path / "absent.csv"), "--positions", str(positions),
                  "-o", str(output), "--n", "2", "--n-slabs", "2"]) == 2
     assert "absent.csv: no such file" in capsys.readouterr().err
+
+
+def test_a_semicolon_separated_file_gets_a_hint(tmp_path):
+    force = tmp_path / "force.csv"
+    force.write_text("t [s];F [N]\n0;1.5\n0,02;1.6\n")
+    with pytest.raises(FileFormatError, match=r"force.csv: one column whose header 't \[s\];F \[N\]' holds ';': the "
+                                              r"file seems separated by ';'"):
+        import_csv(force, force, tmp_path / "run.h5", n=1)

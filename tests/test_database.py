@@ -3,6 +3,7 @@
 import json
 import multiprocessing
 import sqlite3
+import time
 
 import numpy as np
 import pandas as pd
@@ -101,9 +102,27 @@ def _ingest_one(args):
     ingest(database, [record])
 
 
+def _ingest_together(barrier, database, records):
+    """Ingest ``records`` once every writer is ready, each record read slowly: the writers overlap."""
+    read = ingest_module.read_record
+    ingest_module.read_record = lambda path: (time.sleep(0.3), read(path))[1]
+    barrier.wait(timeout=120)
+    ingest(database, records)
+
+
 def test_concurrent_ingests_lose_no_record(toy_results):
     database = "results/default/stickslip.sqlite"
-    with multiprocessing.get_context("spawn").Pool(2) as pool:
+    context = multiprocessing.get_context("spawn")
+    barrier = context.Barrier(2)
+    halves = [[str(r) for r in toy_results[:2]], [str(r) for r in toy_results[2:]]]
+    writers = [context.Process(target=_ingest_together, args=(barrier, database, half)) for half in halves]
+    for writer in writers:
+        writer.start()
+    for writer in writers:
+        writer.join(timeout=300)
+        assert writer.exitcode == 0
+    assert _counts(database)["runs"] == len(toy_results)  # each writer's records: neither replaced the other's
+    with multiprocessing.get_context("spawn").Pool(2) as pool:  # and the same records again change nothing
         pool.map(_ingest_one, [(database, str(r)) for r in toy_results * 2])
     assert _counts(database)["runs"] == len(toy_results)
     assert set(query.runs(database)["run_id"]) == {read_record(r)["run_id"] for r in toy_results}

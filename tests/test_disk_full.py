@@ -63,10 +63,20 @@ def test_a_file_size_limit_is_a_one_line_error_and_the_rerun_gives_the_same_byte
 
 @contextmanager
 def tmpfs(path, options):
-    """Mount a tmpfs at ``path`` (root only; the test is skipped otherwise)."""
+    """Mount a tmpfs at ``path``: skipped if not root, or if mount fails (saying why), failed instead where
+    ``STICKSLIP_REQUIRE_TMPFS`` is set (.ci/run sets it as root)."""
     path.mkdir()
-    if os.geteuid() != 0 or subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(path)]).returncode:
-        pytest.skip("mounting a tmpfs needs root")
+    if os.geteuid() != 0:
+        reason = "mounting a tmpfs needs root"
+    else:
+        mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(path)], capture_output=True,
+                                 text=True)
+        reason = (f"mount -t tmpfs failed as root (exit {mounted.returncode}): "
+                  f"{(mounted.stderr or mounted.stdout).strip()}") if mounted.returncode else None
+    if reason:
+        if os.environ.get("STICKSLIP_REQUIRE_TMPFS"):
+            pytest.fail(reason)
+        pytest.skip(reason)
     try:
         yield path
     finally:

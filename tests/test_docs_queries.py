@@ -54,3 +54,4 @@ def test_the_pandas_examples_give_rows(default_study, monkeypatch):
     frames = {name: value for name, value in namespace.items() if hasattr(value, "empty")}
     assert set(frames) >= {"runs", "events", "mean_dmu", "slowest"}
     assert all(not frame.empty for frame in frames.values()), {name: len(frame) for name, frame in frames.items()}
+    assert namespace["simulation"].header["n"] == 3 and namespace["simulation"].path.is_file()

@@ -14,9 +14,11 @@ import pytest
 
 from stickslip import registry
 from stickslip.events.thermal import ThermalEventParams
+from stickslip.experiment.aging import fit_aging, log_binned
 from stickslip.formats.fem_run import read_increments
 from stickslip.figures import figs_thermal
 from stickslip.figures.experimental_data import EVENTS
+from stickslip.figures.style import plt
 from stickslip.h5io import open_file, read_table
 from stickslip.lineage import Artifact
 from stickslip.params import parse_params
@@ -159,3 +161,37 @@ def test_the_figure_is_drawn_reproducibly_from_the_small_study(study, tmp_path):
 def test_params_of_the_hold_trials():
     params = parse_params(ThermalEventParams, {})
     assert params.hold_times[0] == 0.0 and params.hold_interfaces == 1
+
+
+def test_the_figure_plots_the_numbers_of_its_runs(study):
+    params = parse_params(registry.get("figure", "figS-thermal").params, {"drive_rate": 1e-5})
+    figure = figs_thermal.draw(params, study)
+    shs, held = _tables(study[figs_thermal.THERMAL][3]), _tables(study[figs_thermal.THERMAL][0])
+    # (a) slide-hold-slide: every single slip with a waiting time (T0 = 1 / attempt_rate = 1) and the fit through
+    # the origin, dmu = B ln(nu T)
+    slips = shs["slip_events"]
+    slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
+    assert len(slips) >= 5
+    a = figure.axes[0]
+    [points] = [line for line in a.get_lines() if line.get_marker() == "o" and line.get_linestyle() == "None"]
+    np.testing.assert_array_equal(points.get_xdata(), slips["T"].to_numpy(float))
+    np.testing.assert_array_equal(points.get_ydata(), slips["dmu"].to_numpy(float))
+    bins = log_binned(slips["T"].to_numpy(float), slips["dmu"].to_numpy(float), bins_per_decade=params.bins_per_decade)
+    [squares] = [line for line in a.get_lines() if line.get_marker() == "s"]  # binned means
+    np.testing.assert_array_equal(squares.get_xdata(), bins["T"].to_numpy())
+    np.testing.assert_array_equal(squares.get_ydata(), bins["dmu_mean"].to_numpy())
+    dotted = [line for line in a.get_lines() if line.get_linestyle() == ":"]
+    try:
+        fit = fit_aging(slips["T"].to_numpy(float), slips["dmu"].to_numpy(float), t0=1.0, fit="origin",
+                        bins_per_decade=params.bins_per_decade)
+    except ValueError:  # too few slips per bin in this small run: no fit drawn
+        assert dotted == []
+    else:
+        np.testing.assert_allclose(dotted[0].get_ydata(), fit.B * np.log(dotted[0].get_xdata()), rtol=1e-12)
+    # (b) paired holds of the n = 1 run at the figure's drive rate: the mean peak difference per hold time
+    table = figs_thermal.hold_differences(held["holds"])
+    assert len(table) == len(HOLDS["hold_times"]) - 1  # each hold time against the hold of 0
+    [means] = [line for line in figure.axes[1].get_lines() if line.get_marker() == "o"]
+    np.testing.assert_array_equal(means.get_xdata(), table["hold_time"].to_numpy())
+    np.testing.assert_array_equal(means.get_ydata(), table["mean"].to_numpy())
+    plt.close(figure)

@@ -15,7 +15,7 @@ import time
 
 import pytest
 
-from conftest import FEM_REFERENCE_CASE
+from conftest import FEM_REFERENCE_CASE, kill_when_stored
 from stickslip.cli import main
 from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError, UnreadableFileError
@@ -40,38 +40,13 @@ def _workflow_job(output):
             str(output.with_suffix(".json")), str(output.with_suffix(".log"))]
 
 
-def _kill_when_stored(command, watched, increments, signum, timeout=600):
-    """Start ``command``, wait until ``watched`` holds ``increments`` increments, send ``signum``.
-
-    Returns
-    -------
-    (int, str, int)
-        Exit status, standard error, increments stored when the signal was sent.
-    """
-    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True, env={**os.environ, "NUMBA_NUM_THREADS": "1"})
-    deadline = time.monotonic() + timeout
-    stored = 0
-    while time.monotonic() < deadline and process.poll() is None:
-        try:
-            stored = len(read_increments(watched))  # the running file is readable (SWMR)
-        except FileFormatError:
-            stored = 0  # not created yet
-        if stored >= increments:
-            break
-        time.sleep(0.05)
-    assert process.poll() is None, f"the run ended before {increments} increments: {process.stderr.read()}"
-    process.send_signal(signum)
-    _, err = process.communicate(timeout=120)
-    return process.returncode, err, stored
-
-
 def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(fem_reference_run, tmp_path):
     output = tmp_path / "run.h5"
-    status, err, _ = _kill_when_stored(_cli(output), output, 40, signal.SIGTERM)
+    status, err, _ = kill_when_stored(_cli(output), output, 40, signal.SIGTERM)
     assert status == 128 + signal.SIGTERM, err
     assert "terminated by SIGTERM" in err and "Traceback" not in err
     for increments in (150, 260):  # as by a cluster's wall time after its grace period, or the OOM killer
-        status, _, stored = _kill_when_stored(_cli(output), output, increments, signal.SIGKILL)
+        status, _, stored = kill_when_stored(_cli(output), output, increments, signal.SIGKILL)
         assert status == -signal.SIGKILL
         assert not read_run_attrs(output)["completed"] and read_run_attrs(output)["nstored"] >= stored
     done = subprocess.run(_cli(output), capture_output=True, text=True)
@@ -84,7 +59,7 @@ def test_a_killed_workflow_job_resumes_to_the_same_bytes(fem_reference_run, tmp_
     output = tmp_path / "sim" / "fem" / "run.h5"
     partial, log = partial_path(output), output.with_suffix(".log")
     for signum, increments in ((signal.SIGKILL, 100), (signal.SIGTERM, 220), (signal.SIGINT, 280)):
-        status, _, _ = _kill_when_stored(_workflow_job(output), partial, increments, signum)
+        status, _, _ = kill_when_stored(_workflow_job(output), partial, increments, signum)
         assert status != 0
         assert not output.exists() and partial.exists()
         assert signum != signal.SIGTERM or "terminated by SIGTERM" in log.read_text()

@@ -1,5 +1,6 @@
 """The fem solver against the paper's own regression data, determinism, resume, reruns and the CLI."""
 
+import os
 import shutil
 from pathlib import Path
 
@@ -24,6 +25,12 @@ from stickslip.params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
 
+#: Set (by .ci/run) where the reference must be there: its absence fails instead of skipping.
+REQUIRE_VARIABLE = "STICKSLIP_REQUIRE_REFERENCE"
+
+#: What README.md and docs/fem.md claim: every value to this relative error (measured worst 4.7e-12, sigd).
+CLAIMED_RTOL = 5e-12
+
 pytestmark = pytest.mark.slow
 
 
@@ -34,8 +41,12 @@ def _run(output, **values):
     return params
 
 
-@pytest.mark.skipif(not REFERENCE.is_file(), reason="shared/reference/FixedLever_historic.h5 not available")
 def test_fixed_lever_reproduces_the_reference_on_every_increment(fem_reference_run):
+    if not REFERENCE.is_file():
+        missing = f"{REFERENCE} not available (the paper's regression data, in the shared folder beside the checkout)"
+        if os.environ.get(REQUIRE_VARIABLE):
+            pytest.fail(missing)
+        pytest.skip(missing)
     table = read_increments(fem_reference_run)
     with h5py.File(REFERENCE) as ref:
         expected = {"epsd": ref["epsd"][...], "sigd": ref["sigd"][...], "fxdrive": ref["fxdrive_layers"][...]}
@@ -43,7 +54,7 @@ def test_fixed_lever_reproduces_the_reference_on_every_increment(fem_reference_r
     got = {"epsd": table["epsd"].to_numpy(), "sigd": table["sigd"].to_numpy(),
            "fxdrive": table[[f"fxdrive_{layer}" for layer in range(3)]].to_numpy()}
     for name in got:
-        np.testing.assert_allclose(got[name], expected[name], rtol=1e-9, atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(got[name], expected[name], rtol=CLAIMED_RTOL, atol=1e-300, err_msg=name)
     assert table["kick"].tolist() == [True] + [bool(i % 2 == 0) for i in range(1, 350)]
     attrs = read_run_attrs(fem_reference_run)
     assert attrs["completed"] and attrs["stop_reason"] == "margin"

@@ -98,7 +98,7 @@ def test_the_readers_refuse_a_file_without_a_header_field_or_of_another_format(t
             read(path)
     with h5py.File(path, "r+") as file:
         file.attrs["format"] = "timeseries"
-    with pytest.raises(FileFormatError, match="a timeseries file version 1, expected fem-run"):
+    with pytest.raises(FileFormatError, match="a timeseries file version 2, expected fem-run"):
         fem_run.read_run_attrs(path)
 
 

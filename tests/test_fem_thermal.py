@@ -17,12 +17,12 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
 from scipy import special, stats
 
+from conftest import kill_when_stored
 from stickslip.fem.laws import Cusp, Smooth, backward_barrier, forward_barrier
 from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.fem.random import pcg32_seed
@@ -239,17 +239,10 @@ def test_same_seed_same_bytes_and_a_killed_thermal_run_resumes_to_them(tmp_path)
               for arg in ("--param", f"{key}={','.join(map(str, value)) if isinstance(value, tuple) else value}")]
     command = [sys.executable, "-m", "stickslip", "simulate", "--solver", "fem", *params, "-o", str(killed)]
     for stop in (7, 20, 33):  # after a load increment and after an event increment, twice
-        process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
-        while process.poll() is None:
-            try:
-                stored = read_run_attrs(killed)["nstored"]
-            except Exception:
-                stored = 0
-            if stored >= stop:
-                process.send_signal(signal.SIGKILL)
-                break
-            time.sleep(0.05)
-        process.communicate()
+        status, err, stored = kill_when_stored(command, killed, stop, signal.SIGKILL, timeout=300)
+        assert status == -signal.SIGKILL, err  # killed, not ended by itself
+        attrs = read_run_attrs(killed)
+        assert not attrs["completed"] and attrs["nstored"] >= stored >= stop
     done = subprocess.run(command, capture_output=True, text=True, env=os.environ)
     assert done.returncode == 0, done.stderr
     assert killed.read_bytes() == first.read_bytes()

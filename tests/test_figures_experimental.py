@@ -10,7 +10,10 @@ import pytest
 
 from stickslip import registry
 from stickslip.experiment.timeseries import read_timeseries
-from stickslip.figures import experimental_data, plotting
+from stickslip.experiment.aging import fit_aging, without_slow_slip
+from stickslip.figures import experimental_data, figs_aging_variations, plotting
+from stickslip.figures.experimental_panels import single_slips
+from stickslip.figures.style import plt
 from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
 from stickslip.params import parse_params
@@ -248,3 +251,40 @@ def test_figs_aging_recovery_plots_the_fits_of_each_pair(tmp_path):
     assert y[1] - y[0] > 3 * np.hypot(*errors)
     assert plotted["B_origin:difference"].lines[0].get_xdata()[0] == pytest.approx(0.019)
     assert "B_intercept:a" in plotted and "B_intercept:difference" in plotted
+
+
+def _points(ax):
+    """(T, dmu) pairs of the slips scattered on an aging panel (markers of alpha 0.35), sorted."""
+    lines = [line for line in ax.get_lines() if line.get_alpha() == 0.35 and len(line.get_xdata())]
+    pairs = np.column_stack([np.concatenate([line.get_xdata() for line in lines]),
+                             np.concatenate([line.get_ydata() for line in lines])])
+    return pairs[np.lexsort(pairs.T[::-1])]
+
+
+def _expected(slips):
+    finite = slips[np.isfinite(slips["T"].to_numpy(dtype=float)) & np.isfinite(slips["dmu"].to_numpy(dtype=float))]
+    pairs = finite[["T", "dmu"]].to_numpy(dtype=float)
+    return pairs[np.lexsort(pairs.T[::-1])]
+
+
+def test_figs_aging_variations_plots_the_slips_and_fits_of_its_inputs(study):
+    params = parse_params(figs_aging_variations.FigsAgingVariationsParams, {})
+    figure = figs_aging_variations.draw(params, study)
+    slips = experimental_data.load_slips(study[experimental_data.EVENTS])
+    stack, alone = single_slips(slips, "stack"), single_slips(slips, "individual")
+    quiet = without_slow_slip(stack)
+    assert len(stack) > 50 and 0 < len(quiet) < len(stack) and len(alone) > 10
+    a, b, c, d = figure.axes[:4]
+    for ax in (a, b, c):  # every single stack slip once, by interface and by n
+        np.testing.assert_array_equal(_points(ax), _expected(stack))
+    np.testing.assert_array_equal(_points(d), _expected(quiet))  # (d) without the slips after slow slip
+    assert f"no slow slip: {len(quiet)} of {len(stack)} slips" in [text.get_text() for text in d.texts]
+    individual = [line for line in c.get_lines() if line.get_alpha() == 0.7]  # (c) the interfaces driven alone
+    assert len(individual) == 1
+    np.testing.assert_array_equal(individual[0].get_xdata(), alone["T"].to_numpy())
+    np.testing.assert_array_equal(individual[0].get_ydata(), alone["dmu"].to_numpy())
+    for ax, data in ((a, stack), (d, quiet)):  # the dotted line is the fit through the origin, dmu = B ln(T / T0)
+        fit = fit_aging(data["T"], data["dmu"], t0=params.t0)
+        [dotted] = [line for line in ax.get_lines() if line.get_linestyle() == ":"]
+        np.testing.assert_allclose(dotted.get_ydata(), fit.B * np.log(dotted.get_xdata() / params.t0), rtol=1e-12)
+    plt.close(figure)

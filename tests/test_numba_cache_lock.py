@@ -6,6 +6,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from pathlib import Path
 
 import pytest
 
@@ -28,6 +29,21 @@ def _compile(tmp_path, kind):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
+def _waiting_for(process, path, timeout=120):
+    """Whether ``process`` comes to wait for the flock of ``path`` (Linux /proc/locks: a ``->`` line) in time."""
+    inode = str(os.stat(path).st_ino)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and process.poll() is None:
+        for line in Path("/proc/locks").read_text().splitlines():
+            fields = line.split()
+            if "->" in fields:
+                fields.remove("->")
+                if fields[1] == "FLOCK" and fields[4] == str(process.pid) and fields[5].split(":")[-1] == inode:
+                    return True
+        time.sleep(0.02)
+    return False
+
+
 @pytest.mark.slow
 def test_a_new_cache_entry_waits_for_the_lock_of_its_function(tmp_path):
     (tmp_path / "kernel.py").write_text(KERNEL)
@@ -38,9 +54,12 @@ def test_a_new_cache_entry_waits_for_the_lock_of_its_function(tmp_path):
     assert os.path.exists(lock_path)
     with open(lock_path, "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
+        before = index.stat().st_mtime_ns
         second = _compile(tmp_path, "float")  # a new signature: a new entry in the same index
-        time.sleep(8)  # far longer than importing numba and compiling `twice`
-        assert second.poll() is None, "the cache entry was written while another process held the lock"
+        # seen blocked on the lock by the kernel (not merely slow: a loaded machine delays a child too)
+        assert _waiting_for(second, lock_path), "the cache entry was written without waiting for the lock"
+        time.sleep(0.5)
+        assert second.poll() is None and index.stat().st_mtime_ns == before  # nothing written while it waits
         mtime = index.stat().st_mtime_ns
         fcntl.flock(lock, fcntl.LOCK_UN)
     assert second.communicate(timeout=120)[0].strip() == "6.0"

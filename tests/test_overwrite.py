@@ -8,10 +8,13 @@ aside until the new one is complete).
 
 import hashlib
 import json
+from unittest import mock
 
 import pytest
 
 from stickslip.cli import main
+from stickslip.h5io import FileFormatError
+from stickslip.output_safety.lock import writer_lock
 from stickslip.output_safety.overwrite import OutputExistsError, claimed_output
 from stickslip.workflow_api import run_analysis, run_simulation
 
@@ -57,7 +60,7 @@ def test_a_completed_fem_run_is_not_replaced_by_any_writer(fem_run, tmp_path, ca
     target = tmp_path / "run.h5"
     target.write_bytes(fem_run.read_bytes())
     err = refused(capsys, LEVER + ["-o", str(target)], target)
-    assert "holds a fem-run file of solver fem 3 (this run: format 'timeseries')" in err
+    assert "holds a fem-run file of solver fem 4 (this run: format 'timeseries')" in err
     refused(capsys, RATE_STATE + ["-o", str(target)], target)
     refused(capsys, ["import-csv", *csv_files(tmp_path), "-o", str(target)], target)
     refused(capsys, ["mesh", "-o", str(target)], target)
@@ -72,7 +75,7 @@ def test_each_solver_refuses_another_run_passes_its_own_and_overwrites_when_aske
     made = sha256(target)
     assert main(LEVER + ["-o", str(target)]) == 0 and sha256(target) == made  # the same run again
     err = refused(capsys, LEVER + ["--param", "seed=3", "-o", str(target)], target)
-    assert "holds a timeseries file of solver lever 1 with other parameters: seed = 0 (this run: 3)" in err
+    assert "holds a timeseries file of solver lever 2 with other parameters: seed = 0 (this run: 3)" in err
     err = refused(capsys, RATE_STATE + ["-o", str(target)], target)
     assert "(this run: solver 'rate-state-lever')" in err
     refused(capsys, FEM + ["-o", str(target)], target)
@@ -145,3 +148,29 @@ def test_overwrite_keeps_the_replaced_file_until_the_new_one_is_complete(tmp_pat
         raise KeyboardInterrupt
     assert output.read_text() == "half of the new run"  # resumable
     assert (tmp_path / "out.h5.replaced").read_text() == "another run"  # and nothing lost
+
+
+def test_a_replaced_file_left_by_an_interrupted_overwrite_goes_when_the_run_completes(tmp_path, capsys):
+    output = tmp_path / "out.h5"
+    output.write_text("another run")
+    with pytest.raises(KeyboardInterrupt), claimed_output(output, {"format": "x"}, overwrite=True):
+        output.write_text("half of the new run")
+        raise KeyboardInterrupt
+    assert (tmp_path / "out.h5.replaced").exists()
+    capsys.readouterr()
+    with mock.patch("stickslip.output_safety.overwrite.refuse_other_run"):  # the rerun resumes its own file
+        with claimed_output(output, {"format": "x"}):
+            output.write_text("the new run")
+    assert not (tmp_path / "out.h5.replaced").exists() and output.read_text() == "the new run"
+    assert f"{output} is complete: removed {tmp_path / 'out.h5.replaced'}" in capsys.readouterr().err
+
+
+def test_overwrite_onto_a_file_being_written_is_refused_before_anything_moves(tmp_path):
+    output = tmp_path / "out.h5"
+    output.write_text("a run being written")
+    with writer_lock(output):  # held by "another process": flock conflicts between open files
+        with pytest.raises(FileFormatError, match="another process is writing it"):
+            with claimed_output(output, {"format": "x"}, overwrite=True):
+                pytest.fail("the block must not run")
+        assert output.read_text() == "a run being written"
+        assert not list(tmp_path.glob("out.h5.replaced*"))

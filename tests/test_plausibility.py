@@ -9,7 +9,8 @@ import dataclasses
 import pytest
 
 from stickslip.cli import main
-from stickslip.experiment.plausibility import no_slip_warning, travel_warning
+from stickslip.experiment.plausibility import (force_rate_warning, measured_loading_rate, no_slip_warning,
+                                               travel_warning)
 from stickslip.experiment.virtual.model import simulate
 from stickslip.solvers.lever import LeverParams
 
@@ -22,9 +23,10 @@ def record():
     return signals
 
 
-def export(directory, record, position_scale=1.0, time_scale=1.0):
+def export(directory, record, position_scale=1.0, time_scale=1.0, force_time_scale=None):
     """Write the record as the lab's two CSV files, multiplied by the scales, headers in s, N and mm."""
-    force = ["t [s],F [N]"] + [f"{float(t) * time_scale!r},{float(F)!r}" for t, F in zip(record.t_F, record.F)]
+    force_time_scale = time_scale if force_time_scale is None else force_time_scale
+    force = ["t [s],F [N]"] + [f"{float(t) * force_time_scale!r},{float(F)!r}" for t, F in zip(record.t_F, record.F)]
     header = "t [s]," + ",".join(f"x{i} [mm]" for i in range(1, record.n_slabs + 1))
     rows = [",".join(repr(float(v)) for v in (t * time_scale, *(x * position_scale)))
             for t, x in zip(record.t_x, record.x)]
@@ -45,9 +47,9 @@ def test_a_plausible_record_passes_without_a_word(record, tmp_path, capsys):
 def test_a_record_in_the_wrong_unit_is_named_at_import_and_fails_the_analysis(record, tmp_path, capsys, scales,
                                                                               mistake):
     run = tmp_path / "run.h5"
-    assert main(export(tmp_path, record, *scales)) == 0  # written, with a warning
+    assert main(export(tmp_path, record, *scales)) == 0  # written, with a warning naming the file
     warning = capsys.readouterr().err.splitlines()[-1]
-    assert warning.startswith(f"stickslip: warning: {run}: slab 3 moved ") and mistake in warning, warning
+    assert warning.startswith(f"stickslip: warning: {tmp_path / 'positions.csv'}: slab 3 moved ") and mistake in warning
 
     assert main(["analyze-experiment", str(run), "-o", str(tmp_path / "slips.csv")]) == 2
     err = capsys.readouterr().err.splitlines()
@@ -74,3 +76,32 @@ def test_the_travel_check_measures_the_drive(record):
     assert no_slip_warning(record, 1, "run") is None
     short = dataclasses.replace(record, t_x=record.t_x[:300], x=record.x[:300])  # 60 s: no slip is plausible
     assert no_slip_warning(short, 0, "run") is None
+
+
+def test_a_force_file_in_ms_with_correct_positions_is_named_at_import_and_fails_the_analysis(record, tmp_path,
+                                                                                            capsys):
+    # the audit's case: every check of the positions passes; the force file alone shows the mistake
+    run = tmp_path / "run.h5"
+    assert main(export(tmp_path, record, force_time_scale=1e3)) == 0
+    warnings = capsys.readouterr().err.splitlines()
+    assert len(warnings) == 1 and warnings[0].startswith(f"stickslip: warning: {tmp_path / 'force.csv'}: the lever "
+                                                         "force rises at ")
+    assert "times in ms (not s)" in warnings[0]
+    for argv in (["-o", str(tmp_path / "slips.csv")], ["--aging"]):
+        assert main(["analyze-experiment", str(run), *argv]) == 2
+        err = capsys.readouterr().err.splitlines()
+        assert err[-1].startswith(f"stickslip: error: {run}: ") and "slips have no measured force drop" in err[-1]
+        assert "times in ms (not s) in the force file" in err[-1], err[-1]
+    assert not (tmp_path / "slips.csv").exists()
+
+
+def test_the_force_check_measures_the_loading_rate(record):
+    """The lever force rises at sum_j K (j h V / H)(j h / H) while the slabs stick; scaled records do not."""
+    assert force_rate_warning(record, "force") is None
+    expected = RUN.k_spring * RUN.V * (RUN.h / RUN.H) ** 2 * (1 + 4 + 9)  # n = 3 springs at arms 1, 2, 3 h / H
+    assert measured_loading_rate(record.t_F, record.F) == pytest.approx(expected, rel=0.3)
+    for change, mistake in ((dict(t_F=record.t_F * 1e3), "times in ms (not s)"),
+                            (dict(t_F=record.t_F / 60), "times in min (not s)"),
+                            (dict(F=record.F / 1e3), "force in kN (not N)"), (dict(V=record.V * 1e3),
+                                                                              "V in um/s (not mm/s)")):
+        assert mistake in force_rate_warning(dataclasses.replace(record, **change), "force")

@@ -73,7 +73,21 @@ def test_a_terminal_gets_a_live_bar_redrawn_in_place():
     with progress.bar(3, desc="work", unit="step", stream=stream) as bar:
         bar.update(3)
     assert "\r" in stream.getvalue() and "3/3" in stream.getvalue() and "|" in stream.getvalue()
+    assert " step/s" in stream.getvalue()
+    stream = Terminal()
+    with progress.bar(desc="work", unit="increment", stream=stream) as bar:  # no total: count and unit apart
+        bar.update(149)
+    assert "149 increment" in stream.getvalue() and "149increment" not in stream.getvalue()
 
+
+def test_a_notebook_cell_gets_a_live_bar_as_a_terminal_does():
+    # a Jupyter kernel's output stream (ipykernel.iostream.OutStream) is no TTY; the bar is live there too
+    Cell = type("OutStream", (io.StringIO,), {"__module__": "ipykernel.iostream"})
+    stream = Cell()
+    with progress.bar(3, desc="work", unit="step", stream=stream) as bar:
+        bar.update(3)
+    assert "\r" in stream.getvalue() and "3/3" in stream.getvalue() and "|" in stream.getvalue()
+    assert "elapsed" not in stream.getvalue()  # not the log's lines
 
 def _fem(output, **values):
     plugin = registry.get("solver", "fem")

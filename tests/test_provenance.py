@@ -22,6 +22,25 @@ def test_code_hash_follows_package_imports():
     assert len(code.code_hash("stickslip.h5io")) == 16
 
 
+def test_the_public_api_is_in_no_plugins_code_hash(tmp_path, monkeypatch):
+    # stickslip/__init__.py binds the API (stickslip.api, runs, results, ...): its imports are not the plugins'
+    sources = {p.relative_to(code.ROOT).as_posix() for p in code.module_sources("stickslip.solvers.fem")}
+    assert "__init__.py" in sources and "fem/run.py" in sources
+    assert not {"api.py", "runs.py", "results.py", "events/extraction.py", "provenance/query.py"} & sources
+    package = tmp_path / "stickslip"
+    shutil.copytree(code.ROOT, package, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(code, "ROOT", package)
+    code.module_sources.cache_clear()
+    try:
+        before = {name: code.code_hash(name) for name in ("stickslip.solvers.fem", "stickslip.events.plugin")}
+        extraction = package / "events" / "extraction.py"
+        extraction.write_text(extraction.read_text() + "\n# edited\n")
+        assert code.code_hash("stickslip.solvers.fem") == before["stickslip.solvers.fem"]
+        assert code.code_hash("stickslip.events.plugin") != before["stickslip.events.plugin"]
+    finally:
+        code.module_sources.cache_clear()
+
+
 def test_code_hash_changes_with_the_sources(tmp_path, monkeypatch):
     package = tmp_path / "stickslip"
     shutil.copytree(code.ROOT, package, ignore=shutil.ignore_patterns("__pycache__"))
@@ -56,6 +75,10 @@ def test_record_fields_hashes_and_atomic_write(tmp_path):
     assert record["outputs"][0]["bytes"] == 6
     assert record["wall_time_s"] >= 0 and record["peak_memory_mib"] > 10
     assert record["versions"]["numpy"] and record["versions"]["python"]
+    # the arithmetic: what decides the bits (checked at a resume) and what the host chose (recorded only)
+    assert record["arithmetic"]["decisive"]["numpy"] == record["versions"]["numpy"]
+    assert record["arithmetic"]["host"]["cpu_model"] and record["arithmetic"]["host"]["blas"][0]["kernel"]
+    assert record["versions"]["scipy"] and record["versions"]["llvmlite"] and record["versions"]["qdldl"]
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no temporary left
 
 

@@ -111,7 +111,7 @@ def test_plugins_command_lists_every_format_with_its_reader(toy_plugins, capsys)
     listed = {line.split()[0]: line.strip() for line in lines[1:]}
     # the built-in formats and the one an entry-point package registers, each with its module
     assert set(listed) == {"mesh", "fem-run", "timeseries", "event-table", "front-table", "toy-block"}
-    assert listed["fem-run"].startswith("fem-run 1 ") and listed["fem-run"].endswith("(stickslip.formats.fem_run)")
+    assert listed["fem-run"].startswith("fem-run 2 ") and listed["fem-run"].endswith("(stickslip.formats.fem_run)")
     assert "[numerical]" in listed["fem-run"] and "[experimental]" in listed["timeseries"]
     assert listed["toy-block"].endswith("(stickslip_toy)")
     assert main(["plugins", "--kind", "solver"]) == 0

@@ -6,16 +6,19 @@ user's making (bad parameter, unknown plugin, unreadable file) are printed as on
 line ``stickslip: error: ...`` with exit status 2, never as a traceback. Every command that writes a
 file refuses an existing output that holds another run unless given ``--overwrite``. Ctrl-C and
 SIGTERM end a command cleanly (files closed, what a run stored is kept) with exit
-status 130 (SIGINT) or 143 (SIGTERM).
+status 130 (SIGINT) or 143 (SIGTERM). Warnings of the package (parameters outside the studied regime)
+are one line ``stickslip: warning: ...``.
 """
 
 import argparse
 import importlib
 import sys
+import textwrap
+import warnings
 
 from ..h5io import FileFormatError
 from ..output_safety.errors import OutputError
-from ..params import ParameterError
+from ..params import ParameterError, ParameterWarning
 from ..registry import PluginError
 from ..termination import exit_status, interrupts_raised, interruption
 
@@ -25,6 +28,22 @@ __all__ = ["main", "COMMANDS", "add_overwrite_option"]
 COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db")
 
 USER_ERRORS = (ParameterError, PluginError, FileFormatError, OutputError)
+
+#: What ``stickslip --help`` says first: what the tool is for, in the user's terms.
+DESCRIPTION = textwrap.fill("Stick-slip in a stack of elastic slabs: run the paper's simulations (finite elements, a virtual "
+               "lever experiment), analyse lab or simulated recordings (slips, force drops, aging), and query the "
+               "results database. The whole study runs with `snakemake --cores 2`; these commands run or inspect "
+               "one piece of it.", 100)
+
+#: What ``stickslip --help`` says last: where to start.
+EPILOG = ("examples:\n"
+          "  stickslip plugins --params                       the solvers and their parameters\n"
+          "  stickslip simulate --solver fem --param N=162 -o run.h5\n"
+          "  stickslip increments run.h5 -o run.csv           the increments of a run, also while it runs\n"
+          "  stickslip import-csv --force F.csv --positions X.csv --n 3 -o lab.h5\n"
+          "  stickslip analyze-experiment lab.h5 -o slips.csv --aging\n"
+          "  stickslip db events --regime stiff               slip events of the study's database\n"
+          "`stickslip COMMAND --help` describes each command; README.md and docs/ the study.")
 
 
 def add_overwrite_option(parser):
@@ -39,7 +58,8 @@ def build_parser():
     """Return the top-level argument parser with every sub-command."""
     from .. import __version__
 
-    parser = argparse.ArgumentParser(prog="stickslip", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="stickslip", description=DESCRIPTION, epilog=EPILOG,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS:
@@ -47,8 +67,19 @@ def build_parser():
     return parser
 
 
+def _one_line_warning(message, category, filename, lineno, line=None):
+    """``warnings`` output: the package's own warnings as one line, others as Python prints them."""
+    if issubclass(category, ParameterWarning):
+        return f"stickslip: warning: {message}\n"
+    return _python_warning(message, category, filename, lineno, line)
+
+
+_python_warning = warnings.formatwarning
+
+
 def main(argv=None):
     """Run the command line; return the exit status."""
+    warnings.formatwarning = _one_line_warning
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

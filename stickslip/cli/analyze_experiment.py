@@ -2,7 +2,8 @@
 
 A record implausible for the apparatus it claims (:mod:`stickslip.experiment.plausibility`: a unit
 mistake) gets a one-line warning; if no slip is found at all, the command then fails (exit 2) instead
-of writing an empty result.
+of writing an empty result, and so does a record whose slips mostly have no measured force drop (its
+force and positions cover other times: one line naming the file and the likely unit).
 """
 
 import sys
@@ -10,9 +11,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..experiment.aging import FITS, fit_aging, fit_aging_per_interface
+from ..experiment.aging import FITS, fit_single_slips
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
-from ..experiment.plausibility import no_slip_warning, travel_warning
+from ..experiment.plausibility import force_rate_warning, missing_drop_error, no_slip_warning, travel_warning
 from ..experiment.timeseries import read_timeseries
 from ..output_safety.overwrite import write_text_output
 from ..params import ParameterError, parse_assignments, parse_params
@@ -58,7 +59,11 @@ def run(args):
         record = read_timeseries(path)
         slips, _ = analyse_record(record, params)
         tables.append(slips.assign(run=str(path)))
-        found = (travel_warning(record, str(path)), no_slip_warning(record, len(slips), str(path)))
+        missing = missing_drop_error(record, slips, str(path))
+        if missing:
+            raise ParameterError(missing)
+        found = (force_rate_warning(record, str(path)), travel_warning(record, str(path)),
+                 no_slip_warning(record, len(slips), str(path)))
         warnings += [line for line in found if line]
     for line in warnings:
         print(f"stickslip: warning: {line}", file=sys.stderr)
@@ -70,15 +75,14 @@ def run(args):
         write_text_output(args.output, slips.to_csv(index=False), overwrite=args.overwrite)
         print(f"{len(slips)} slips ({int(slips['multi'].sum())} in multi-interface events) -> {args.output}")
     if args.aging:
-        single = slips[~slips["multi"].to_numpy(dtype=bool)]
         print(f"aging fit ({args.fit}) on the single slips in logarithmic bins of T (T0 = {params.t0} s)")
         if args.per_interface:
-            for a, fit in fit_aging_per_interface(single, t0=params.t0, fit=args.fit).items():
+            for a, fit in fit_single_slips(slips, t0=params.t0, fit=args.fit, per_interface=True).items():
                 print(f"a={a} " + (_fit_line(fit, intercept=True) if not isinstance(fit, ValueError)
                                    else f"no fit: {fit}"))
         else:
             try:
-                fit = fit_aging(single["T"], single["dmu"], t0=params.t0, fit=args.fit)
+                fit = fit_single_slips(slips, t0=params.t0, fit=args.fit)
             except ValueError as error:
                 hint = "; the records are implausible for their apparatus (warnings above)" if warnings else ""
                 raise ParameterError(f"{error}{hint}") from None

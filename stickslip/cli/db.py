@@ -1,7 +1,8 @@
 """``stickslip db``: query and (re)build the results database.
 
 Sub-commands: ``runs`` and ``events`` (filters, ``--format table|csv|json``),
-``sql "SELECT ..."`` (read-only connection), ``ingest RECORD...`` (add records),
+``sql "SELECT ..."`` (read-only connection; Ctrl-C stops it at once; time, rows and memory bounded by
+default, ``--time-limit``, ``--max-rows``, ``--memory-limit``), ``ingest RECORD...`` (add records),
 ``rebuild`` (recreate the database from the records under the results directory).
 Each study has its own database, ``results/{study}/stickslip.sqlite``: ``--study NAME``
 chooses it (default: ``default``), ``--db FILE`` names any file.
@@ -13,7 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..formats.fem_run import REGIMES
 from ..h5io import FileFormatError
+from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
 
 FORMATS = ("table", "csv", "json")
 
@@ -58,7 +61,7 @@ def add_parser(subparsers):
     runs.add_argument("--plugin")
     runs.add_argument("--solver")
     runs.add_argument("--n", type=int, help="number of driven interfaces")
-    runs.add_argument("--regime")
+    runs.add_argument("--regime", choices=REGIMES)
     runs.add_argument("--seed", type=int)
     runs.set_defaults(func=run_runs)
 
@@ -69,7 +72,7 @@ def add_parser(subparsers):
     events.add_argument("--source", choices=("numerical", "experimental"))
     events.add_argument("--n", type=int, help="number of driven interfaces")
     events.add_argument("--interface", type=int, help="interface (slab) a, 1 = lowest")
-    events.add_argument("--regime")
+    events.add_argument("--regime", choices=REGIMES)
     events.add_argument("--seed", type=int)
     events.add_argument("--run-id", help="one simulation")
     events.set_defaults(func=run_events)
@@ -77,6 +80,14 @@ def add_parser(subparsers):
     sql = command("sql", "run SQL on a read-only connection")
     _common(sql)
     sql.add_argument("query", help='e.g. "SELECT n, COUNT(*) FROM simulations GROUP BY n"')
+    sql.add_argument("--time-limit", type=float, default=TIME_LIMIT_S, metavar="SECONDS",
+                     help=f"stop the query after this long (default {TIME_LIMIT_S:g}; 0: no limit); Ctrl-C stops it "
+                          "at any time")
+    sql.add_argument("--max-rows", type=int, default=MAX_ROWS, metavar="N",
+                     help=f"refuse a result of more rows (default {MAX_ROWS}; 0: no limit)")
+    sql.add_argument("--memory-limit", type=float, default=MEMORY_LIMIT_MIB, metavar="MIB",
+                     help=f"SQLite's memory, sorts and temporary tables included (default {MEMORY_LIMIT_MIB}; "
+                          "0: no limit)")
     sql.set_defaults(func=run_sql)
 
     ingest = command("ingest", "add provenance records to the database (idempotent)")
@@ -139,7 +150,8 @@ def run_events(args):
 
 def run_sql(args):
     """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2."""
-    return _query(args, "sql", None, args.query)
+    return _query(args, "sql", None, args.query, time_limit=args.time_limit, max_rows=args.max_rows,
+                  memory_limit_mib=args.memory_limit)
 
 
 def run_ingest(args):

@@ -1,7 +1,8 @@
 """``stickslip import-csv``: convert a lab export (force CSV + positions CSV) into a time-series file.
 
-A record implausible for the apparatus it claims (a unit mistake, :mod:`stickslip.experiment.plausibility`)
-is written, with a one-line warning.
+Each file is checked against the apparatus it claims (:mod:`stickslip.experiment.plausibility`: the force's
+loading rate, the positions' travel); an implausible one (a unit mistake) is written, with a one-line
+warning naming the CSV file.
 """
 
 from pathlib import Path
@@ -9,7 +10,7 @@ from pathlib import Path
 import sys
 
 from ..experiment.csv_import import UNITS, import_csv
-from ..experiment.plausibility import travel_warning
+from ..experiment.plausibility import force_rate_warning, travel_warning
 from ..experiment.timeseries import PROTOCOLS
 from . import add_overwrite_option
 
@@ -50,7 +51,7 @@ def run(args):
                         h=args.h, H=args.H, V=args.V, time_unit=args.time_unit, force_unit=args.force_unit,
                         position_unit=args.position_unit, overwrite=args.overwrite)
     print(f"{args.output}: {record.t_F.size} force samples, {record.t_x.size} frames of {record.n_slabs} slabs")
-    warning = travel_warning(record, str(args.output))
-    if warning:
-        print(f"stickslip: warning: {warning}", file=sys.stderr)
+    for warning in (force_rate_warning(record, str(args.force)), travel_warning(record, str(args.positions))):
+        if warning:
+            print(f"stickslip: warning: {warning}", file=sys.stderr)
     return 0

@@ -1,13 +1,12 @@
 """``stickslip simulate``: run one solver on parameters given as KEY=VALUE."""
 
 import argparse
+import os
 from pathlib import Path
 
-from .. import registry
-from ..numba_options import set_num_threads
-from ..output_safety.atomic import check_output
-from ..output_safety.overwrite import claimed_output
-from ..params import params_to_dict, parse_assignments, parse_params
+from ..arithmetic import CONTINUE_VARIABLE
+from ..params import parse_assignments
+from ..solver_run import run_solver
 from . import add_overwrite_option
 
 
@@ -25,8 +24,11 @@ def add_parser(subparsers):
                         help="output file (HDF5); an existing one of the same run is resumed (fem) or written "
                              "again, one of another run is refused")
     add_overwrite_option(parser)
+    parser.add_argument("--resume-other-arithmetic", action="store_true",
+                        help="resume a run although the packages that decide its bits (numpy, scipy, numba, "
+                             "llvmlite, qdldl, h5py, Python, libm) differ from those it was started with; the file "
+                             f"records from which increment (also: {CONTINUE_VARIABLE}=1)")
     parser.set_defaults(func=run)
-
 
 
 def positive_int(text):
@@ -40,18 +42,10 @@ def positive_int(text):
     return value
 
 
-def run_identity(plugin, params):
-    """What a solver's output file stores about its run (root attributes): format, solver, version, parameters."""
-    return {"format": plugin.produces, "solver": plugin.name, "solver_version": plugin.version,
-            "params": params_to_dict(params)}
-
-
 def run(args):
-    """Validate the parameters and the output, then run the solver."""
-    plugin = registry.get("solver", args.solver)
-    params = parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
-    threads = set_num_threads(args.threads)
-    check_output(args.output)
-    with claimed_output(args.output, run_identity(plugin, params), overwrite=args.overwrite):
-        plugin.run(params, args.output, threads=threads, inputs={})
+    """Validate the parameters and the output, then run the solver (:func:`stickslip.solver_run.run_solver`)."""
+    if args.resume_other_arithmetic:
+        os.environ[CONTINUE_VARIABLE] = "1"
+    run_solver(args.solver, args.output, parse_assignments(args.param), threads=args.threads,
+               overwrite=args.overwrite)
     return 0

@@ -375,10 +375,7 @@ def solver_replay(input, analysis=NAME):
     if not isinstance(input, Artifact):
         raise FileFormatError(f"{input}: {analysis} needs the lineage of its input (a "
                               "stickslip.lineage.Artifact naming the solver that wrote it)")
-    solver = registry.get("solver", input.plugin)
-    if solver.replay is None:
-        raise FileFormatError(f"{input}: solver {solver.name!r} that wrote it cannot replay events")
-    return solver.replay(input.path)
+    return registry.replay(input.plugin, input.path)
 
 
 @register("analysis", NAME, VERSION, FrontParams, consumes=("fem-run",), produces="front-table")

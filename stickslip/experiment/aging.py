@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["T0", "SLOW_SLIP_DRIFT", "FITS", "AgingFit", "log_binned", "fit_aging", "fit_aging_per_interface",
-           "aging_rate", "spread_of_aging_rate", "slow_slip_fraction", "without_slow_slip"]
+           "fit_single_slips", "aging_rate", "spread_of_aging_rate", "slow_slip_fraction", "without_slow_slip"]
 
 #: Microscopic time scale of the aging law [s].
 T0 = 1.0
@@ -187,6 +187,38 @@ def fit_aging_per_interface(slips, *, t0=T0, fit="origin", bins_per_decade=4, mi
         except ValueError as error:
             results[int(a)] = error
     return results
+
+
+def fit_single_slips(slips, *, t0=T0, fit="origin", per_interface=False):
+    """The paper's aging fit of an analysed recording: :func:`fit_aging` on its single slips.
+
+    Slips in multi-interface events are left out (their ``dmu`` is not defined: the lever
+    kinematics of one slip does not apply).
+
+    Parameters
+    ----------
+    slips : pandas.DataFrame
+        One row per slip (:func:`stickslip.experiment.analysis.analyse_record`): columns ``a``,
+        ``multi``, ``T`` [s], ``dmu``; the slips of one or several recordings.
+    t0, fit
+        See :func:`fit_aging`.
+    per_interface : bool, optional
+        Fit each interface separately (:func:`fit_aging_per_interface`).
+
+    Returns
+    -------
+    AgingFit or dict[int, AgingFit or ValueError]
+        The fit over every interface, or per interface.
+
+    Raises
+    ------
+    ValueError
+        Over every interface: if the single slips fill too few bins (:func:`fit_aging`).
+    """
+    single = slips[~slips["multi"].to_numpy(dtype=bool)]
+    if per_interface:
+        return fit_aging_per_interface(single, t0=t0, fit=fit)
+    return fit_aging(single["T"], single["dmu"], t0=t0, fit=fit)
 
 
 def aging_rate(dmu, T, *, t0=T0):

@@ -44,6 +44,16 @@ UNITS = {
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
 
 
+def _refuse_semicolons(path):
+    """Raise FileFormatError with a hint if the header line is separated by ';' (a European spreadsheet's CSV)."""
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        header = next((line.strip() for line in handle if line.strip() and not line.startswith("#")), "")
+    if ";" in header and "," not in header:
+        raise FileFormatError(f"{path}: one column whose header {header!r} holds ';': the file seems separated by "
+                              f"';' (a European export); expected ',' between columns (save it as CSV with ',' as "
+                              f"separator and '.' as decimal point)")
+
+
 def _parse_header(path, header):
     """Map each column name to its unit ('' when the header has none)."""
     columns = {}
@@ -101,6 +111,7 @@ def read_csv_columns(path, quantities, units):
     path = Path(path)
     if not path.is_file():
         raise FileFormatError(f"{path}: no such file")
+    _refuse_semicolons(path)
     try:
         table = pd.read_csv(path, comment="#", header=None, dtype=str, skipinitialspace=True,
                             keep_default_na=False)

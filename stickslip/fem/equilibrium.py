@@ -19,10 +19,14 @@ so an accepted solve is a local minimum of the energy. ``U`` [nfree, nlayer] the
 [nlayer, nlayer] the drive: ``k V_l`` on the diagonal (fixed lever), times
 ``I - r r^T / (1 + r.r)`` with a free lever (``r_l = h_l / H``). The periodic wrap is
 in the DOF numbering (images share a DOF). ``K_p + K_i`` is sparse, symmetric and
-positive definite (the bottom edge is fixed): it is factorised once with SuperLU
-(:func:`scipy.sparse.linalg.splu`); the drive is added by the Woodbury identity
-(``A^-1 b = y - Z (I + M U^T Z)^-1 M U^T y``, ``y = (K_p + K_i)^-1 b``,
-``Z = (K_p + K_i)^-1 U``). For an all-elastic model (the linear response) ``A`` is
+positive definite (the bottom edge is fixed): it is factorised once as ``P L D L^T P^T`` by
+QDLDL (the ``qdldl`` package: ``P`` SuiteSparse's approximate minimum degree ordering, integer
+arithmetic only; the factorisation and the triangular solves plain serial C loops, with no BLAS);
+the drive is added by the Woodbury identity (``A^-1 b = y - Z (I + M U^T Z)^-1 M U^T y``,
+``y = (K_p + K_i)^-1 b``, ``Z = (K_p + K_i)^-1 U``), its small dense products and inverse in a
+fixed order (:mod:`stickslip.fixed_order`). Nothing here depends on the CPU's BLAS kernel: the solve gives
+the same bits on every x86-64 host (``benchmarks/host_bytes.py`` compares them under every OpenBLAS
+kernel a host supports; SuperLU, used before, calls the BLAS and did not). For an all-elastic model (the linear response) ``A`` is
 the exact stiffness and one iteration is the solution.
 
 The iterations stop when the relative residual (:func:`.dynamics.residual`, at rest)
@@ -37,10 +41,11 @@ is the same bit for bit on every run.
 """
 
 import numpy as np
+import qdldl
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from .assembly import assemble_csr, elastic_element_stiffness
+from ..fixed_order import columns_dot_dense, inverse, matmul, woodbury_correct
 
 __all__ = ["WellEquilibrium", "MAX_NEWTON", "STALL"]
 
@@ -48,6 +53,22 @@ __all__ = ["WellEquilibrium", "MAX_NEWTON", "STALL"]
 MAX_NEWTON = 200
 #: Give up when the residual has not halved in this many consecutive iterations.
 STALL = 10
+
+
+def _drive_matrix(model):
+    """The drive's ``M`` [nlayer, nlayer] (module docstring), each entry in a fixed order of operations."""
+    nlayer = model.layer_volume.size
+    stiffness = [model.k_drive * float(model.layer_volume[l]) if model.drive_active[l] else 0.0 for l in range(nlayer)]
+    M = np.diag(stiffness)
+    if model.free_lever:
+        r = [float(model.lever_ratio[l]) if model.drive_active[l] else 0.0 for l in range(nlayer)]
+        norm = 1.0
+        for value in r:
+            norm += value * value
+        for i in range(nlayer):
+            for j in range(nlayer):
+                M[i, j] = stiffness[i] * ((1.0 if i == j else 0.0) - r[i] * r[j] / norm)
+    return M
 
 
 class WellEquilibrium:
@@ -75,30 +96,21 @@ class WellEquilibrium:
         ke = elastic_element_stiffness(model.iface_dNdx, model.iface_dV, *model.law.newton_moduli())
         interfaces = sp.csr_matrix(assemble_csr(model.iface_dofs, ke, ndof)[::-1], shape=(ndof, ndof))
         self.matrix = (plates + interfaces)[self.free][:, self.free].tocsc()
-        self._lu = splu(self.matrix, permc_spec="MMD_AT_PLUS_A")
+        self._ldl = qdldl.Solver(self.matrix)
         position = np.full(ndof, -1, dtype=np.int64)
         position[self.free] = np.arange(self.free.size)
         nlayer = model.layer_volume.size
-        rows, cols, vals = [], [], []
-        for layer in range(nlayer):
-            if not model.drive_active[layer]:
-                continue
+        weights = np.zeros((self.free.size, nlayer))  # U, dense
+        for layer in np.flatnonzero(model.drive_active):
             span = slice(model.layer_ptr[layer], model.layer_ptr[layer + 1])
             dofs = position[model.layer_xdofs[span]]
             keep = dofs >= 0
-            rows.append(dofs[keep])
-            cols.append(np.full(int(keep.sum()), layer))
-            vals.append(model.layer_w[span][keep])
-        self._U = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                                shape=(self.free.size, nlayer)) if rows else sp.csr_matrix((self.free.size, nlayer))
-        stiffness = np.where(model.drive_active, model.k_drive * model.layer_volume, 0.0)
-        M = np.diag(stiffness)
-        if model.free_lever:
-            r = np.where(model.drive_active, model.lever_ratio, 0.0)
-            M = M @ (np.eye(nlayer) - np.outer(r, r) / (1.0 + r @ r))
-        self._M = M
-        self._Z = self._lu.solve(self._U.toarray())
-        self._capacitance = np.linalg.inv(np.eye(nlayer) + M @ (self._U.T @ self._Z))
+            np.add.at(weights[:, layer], dofs[keep], model.layer_w[span][keep])
+        U = sp.csc_matrix(weights)
+        self._U = (U.indptr.astype(np.int64), U.indices.astype(np.int64), U.data)
+        self._Z = np.asfortranarray(np.column_stack([self._ldl.solve(weights[:, layer]) for layer in range(nlayer)]))
+        M = _drive_matrix(model)
+        self._gain = matmul(inverse(np.eye(nlayer) + matmul(M, columns_dot_dense(*self._U, self._Z))), M)
 
     def solve(self, b):
         """``A^-1 b`` on the free DOFs.
@@ -113,11 +125,8 @@ class WellEquilibrium:
         numpy.ndarray
             [nfree].
         """
-        y = self._lu.solve(b)
-        c = self._capacitance @ (self._M @ (self._U.T @ y))
-        for layer in range(c.size):
-            if c[layer] != 0.0:
-                y -= c[layer] * self._Z[:, layer]
+        y = self._ldl.solve(np.ascontiguousarray(b, dtype=np.float64))
+        woodbury_correct(y, self._gain, *self._U, self._Z)
         return y
 
     def relax(self, backend, tol):

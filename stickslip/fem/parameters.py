@@ -6,13 +6,16 @@ dimensionless. See docs/fem.md and shared/reference-model.md (section 11).
 """
 
 import dataclasses
+import math
+import warnings
 
 from ..formats import fem_run
-from ..params import ParameterError, param, parse_params
+from ..params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
 
-__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "stored_params"]
+__all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "CYCLE_STRAIN", "REACH_MIN", "REACH_REGIME",
+           "REACH_MELT", "thermal_reach", "stored_params"]
 
 #: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
 DRIVES = ("fixed-lever", "free-lever")
@@ -24,6 +27,43 @@ RELAXATIONS = ("dynamic", "exact")
 #: What happens when a block nears the end of the yield strains held in memory: they are drawn further
 #: (the run goes on), or the run stops (the paper's code).
 SEQUENCE_ENDS = ("extend", "stop")
+
+
+#: Drive of one stick-slip cycle [eps0] (docs/fem.md, "Temperature and drive rate against the apparatus").
+CYCLE_STRAIN = 0.2
+#: Thermal reach ``T ln(nu t_cycle)`` (barrier units) below which no barrier above round-off is crossed:
+#: the thermal protocol would be the athermal one at the cost of the kinetic Monte Carlo (refused).
+REACH_MIN = 1e-12
+#: The regime the studies stay in (docs/fem.md, "Limits of the regime": fine at 0.023, T = 1e-3 with
+#: drive_rate 2e-11; flips of two-level blocks took over at 0.030, 1e-3 with 2e-14): beyond it, warned.
+REACH_REGIME = 0.025
+#: Reach at which a block eps0 below its yield strain (the unit barrier) hops within a cycle: every
+#: interface flows, and the event-driven method describes nothing (refused).
+REACH_MELT = 1.0
+
+
+def thermal_reach(temperature, attempt_rate, drive_rate):
+    """The barrier crossed during one stick-slip cycle, ``T ln(nu t_cycle)`` [G eps0^2 h^2].
+
+    Parameters
+    ----------
+    temperature : float
+        [G eps0^2 h^2].
+    attempt_rate : float
+        ``nu`` [1/time].
+    drive_rate : float
+        [eps0/time]; a cycle lasts ``t_cycle = CYCLE_STRAIN / drive_rate``.
+
+    Returns
+    -------
+    float
+        The reach; ``nan`` if a cycle lasts no attempt time (``nu t_cycle <= 1``) or its length
+        is not a finite number.
+    """
+    attempts = attempt_rate * (CYCLE_STRAIN / drive_rate)
+    if not math.isfinite(attempts) or attempts <= 1.0:
+        return math.nan
+    return temperature * math.log(attempts)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -109,6 +149,11 @@ class FemParams:
         self._check_law()
         if self.temperature > 0.0 and self.yield_strains != "extend":
             raise ParameterError("parameter 'yield_strains': a thermal run (temperature > 0) needs 'extend'")
+        if self.hold_delay != 0.0 and not self.hold_times:
+            raise ParameterError(f"parameter 'hold_delay': {self.hold_delay:g} is used only with hold_times; expected "
+                                 "hold_times (e.g. hold_times=[1e3, 1e6]) or the default 0")
+        if self.temperature > 0.0:
+            _refuse_or_warn_reach(self)
         if self.temperature == 0.0:
             for name in ("attempt_rate", "drive_rate", "hold_times", "hold_delay"):
                 field = self.__dataclass_fields__[name]
@@ -118,7 +163,6 @@ class FemParams:
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
-
 
     def _check_law(self):
         law = INTERFACE_LAWS[self.interface_law]
@@ -132,6 +176,36 @@ class FemParams:
         if self.temperature > 0.0 and not law.thermal:
             raise ParameterError(f"parameter 'temperature': law '{law.name}' has no exact barriers for thermal "
                                  "activation; expected 0")
+
+
+def _refuse_or_warn_reach(params):
+    """Raise ParameterError if the thermal reach is outside what the method represents; warn beyond the regime."""
+    p = params
+    reach = thermal_reach(p.temperature, p.attempt_rate, p.drive_rate)
+    cycle = f"a stick-slip cycle ({CYCLE_STRAIN:g} eps0 of drive)"
+    if math.isnan(reach):
+        raise ParameterError(f"parameter 'drive_rate': {p.drive_rate:g} eps0/time drives {cycle} in "
+                             f"{CYCLE_STRAIN / p.drive_rate:.3g} time, not more than one attempt time 1/attempt_rate "
+                             f"= {1.0 / p.attempt_rate:.3g} (or no finite time): thermal activation cannot act; expected "
+                             f"0 < drive_rate < {CYCLE_STRAIN * p.attempt_rate:g} (docs/fem.md, 'Limits of the regime')")
+    log_attempts = reach / p.temperature
+    if reach < REACH_MIN:
+        raise ParameterError(f"parameter 'temperature': {p.temperature:g} reaches a barrier of {reach:.3g} "
+                             f"G eps0^2 h^2 in {cycle}, below {REACH_MIN:g}: no barrier above round-off is crossed; "
+                             f"expected 0 (the athermal protocol) or >= {REACH_MIN / log_attempts:.3g} "
+                             f"(docs/fem.md, 'Limits of the regime')")
+    if reach > REACH_MELT:
+        raise ParameterError(f"parameter 'temperature': {p.temperature:g} reaches a barrier of {reach:.3g} "
+                             f"G eps0^2 h^2 in {cycle}, above {REACH_MELT:g} (a block eps0 below its yield strain "
+                             f"hops at once: the interfaces flow); expected <= {REACH_MELT / log_attempts:.3g}, the "
+                             f"studied regime T ln(nu t_cycle) <= {REACH_REGIME:g} at <= "
+                             f"{REACH_REGIME / log_attempts:.3g} (docs/fem.md, 'Limits of the regime')")
+    if reach > REACH_REGIME:
+        warnings.warn(f"parameters 'temperature', 'drive_rate': thermal reach T ln(nu t_cycle) = {reach:.3g}, beyond "
+                      f"the regime T ln(nu t_cycle) <= {REACH_REGIME:g} (temperature <= "
+                      f"{REACH_REGIME / log_attempts:.3g} at this drive rate) where the studies stay: flips of "
+                      "two-level blocks may take over the run (docs/fem.md, 'Limits of the regime')", ParameterWarning,
+                      stacklevel=2)
 
 
 def stored_params(file):

@@ -6,7 +6,8 @@ model is built once per run file; each replay restores the stored state before t
 and runs the same kick and relaxation as the run
 (:meth:`.protocol.AthermalProtocol.perturb_and_relax` with :class:`.loading.KickAlongResponse`).
 For a thermal run it also holds a stored state at a load and reloads it
-(:meth:`EventReplay.hold`, :mod:`.thermal.holds`).
+(:meth:`EventReplay.hold`, :mod:`.thermal.holds`), and for any run it gives the interface fields of
+a stored increment (:meth:`EventReplay.interface_state`, what :meth:`stickslip.runs.FemRun.state` shows).
 """
 
 import numpy as np
@@ -67,6 +68,37 @@ class EventReplay:
         if self.params.temperature <= 0.0:
             raise FileFormatError(f"{self.path}: an athermal run (temperature = 0) has no hold trials")
         return hold_trial(self.simulation, self._state(increment), hold_time, below, replica)
+
+    def interface_state(self, increment):
+        """Strain, stress and well of every interface Gauss point at a stored increment.
+
+        The stored state is restored on the run's model (nothing is re-run): these are the fields
+        from which the run computed that increment's observables.
+
+        Parameters
+        ----------
+        increment : int
+            A stored increment.
+
+        Returns
+        -------
+        dict[str, numpy.ndarray]
+            ``eps``: float64 [n_interfaces, N, 4, 3] strain (xx, yy, xy) [1]; ``sig``: float64
+            [n_interfaces, N, 4, 3] stress (xx, yy, xy) [FE stress, the unit of ``G``] (the run file's
+            ``eps0`` and ``sig0`` are the units of its observables); ``well``: int64 [n_interfaces, N, 4]
+            the well each Gauss point is in, counted from the start of its block's yield-strain
+            sequence. Interfaces a = 1 (lowest) first, blocks left to right, the element's 4 Gauss points.
+
+        Raises
+        ------
+        FileFormatError
+            If the increment is not stored.
+        """
+        stack = self.simulation.stack
+        stack.restore(*self._state(increment))
+        eps, sig = stack.backend.read("eps", "sig")
+        return {"eps": eps.reshape(-1, self.N, 4, 3).copy(), "sig": sig.reshape(-1, self.N, 4, 3).copy(),
+                "well": stack.well_index().reshape(-1, self.N, 4)}
 
     def failures(self, increment):
         """Redo one kick increment and record every well hop of the interface blocks.

@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from .. import progress
-from ..formats.fem_run import RunFile, append_increment, create_file, rewrite
+from ..formats.fem_run import RunFile, append_increment, check_arithmetic, create_file, rewrite
 from ..h5io import FileFormatError, UnreadableFileError, open_file, read_table
 from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
-from ..output_safety.overwrite import set_aside
+from ..output_safety.overwrite import changed_values, set_aside
 from ..output_safety.space import check_free_space
 from ..params import params_to_dict
 from .observables import Observer, observable_columns
@@ -120,7 +120,9 @@ def _stored(output, params):
         print(f"stickslip: {error}; moved it to {aside}, starting the run over", file=sys.stderr)
         return None
     if params_to_dict(stored) != params_to_dict(params):
-        raise FileFormatError(f"{output}: exists with other parameters; remove it or use another output")
+        raise FileFormatError(f"{output}: exists with other parameters: "
+                              f"{changed_values(params_to_dict(stored), params_to_dict(params))}; remove it or use "
+                              f"another output")
     return completed
 
 
@@ -172,7 +174,7 @@ def run_simulation(params, output, mesh, backend, *, producer):
         if completed is None:
             _create(output, params, mesh, backend, producer)
         else:
-            rewrite(output)
+            rewrite(output, **check_arithmetic(output))
         new, reason = _increments(params, output, backend)
         rewrite(output, completed=True, stop_reason=reason)
         return new

@@ -202,7 +202,7 @@ def describe(name, path):
 
 for _builtin in (
         Format("mesh", 1, "stickslip.mesh.io", "a layered Quad4 mesh (coordinates, connectivity, layers)"),
-        Format("fem-run", 1, "stickslip.formats.fem_run", "a quasistatic finite-element run: header, mesh, linear "
+        Format("fem-run", 2, "stickslip.formats.fem_run", "a quasistatic finite-element run: header, mesh, linear "
                "response, one state and one row of observables per increment", source="numerical",
                describe="stickslip.formats.fem_run:describe"),
         Format("timeseries", 1, "stickslip.experiment.timeseries", "an experimental recording: lever force F(t), "

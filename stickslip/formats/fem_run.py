@@ -17,8 +17,11 @@ equal runs give equal bytes):
     the producer (``fem``: ``drive``, ``nchunk``, ``alpha``, ``H``; a thermal ``fem`` run also
     ``protocol`` = "thermal", ``temperature``, ``attempt_rate``, ``drive_rate``, ``hold_times``,
     ``hold_delay``, ``energy_unit``: docs/fem.md, "Finite temperature"); then ``version``
-    (package), ``nstored`` (complete increments) and ``completed`` (bool) with
-    ``stop_reason`` ("margin" or "max_increments").
+    (package), ``arithmetic`` (what decides the bits of the numbers: a JSON list of segments, each
+    :func:`stickslip.arithmetic.decisive` with the ``from_increment`` it holds from; one segment unless
+    a resume was told to continue under another, :func:`check_arithmetic`), ``nstored`` (complete
+    increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or "max_increments").
+    Format version 2 added ``arithmetic``.
 ``/mesh``
     The layered mesh (:func:`stickslip.mesh.save_mesh`); with it the run's own interface
     <-> layer map (``interface_elements``, ``elem_layer``; :func:`stickslip.mesh.interface_layer`).
@@ -46,12 +49,13 @@ import numbers
 import numpy as np
 
 from .. import __version__, formats
+from ..arithmetic import check_resume, decisive
 from ..h5io import FileFormatError, copy_file, open_file, read_array, read_table, write_attrs, write_dataset
 from ..mesh import load_mesh, save_mesh
 from ..output_safety.atomic import atomic_output
 
 __all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
-           "read_increments", "read_run_attrs", "RunFile", "describe"]
+           "read_increments", "read_run_attrs", "RunFile", "describe", "check_arithmetic"]
 
 #: The format name of these files (:mod:`stickslip.formats`).
 FORMAT = "fem-run"
@@ -123,7 +127,9 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None):
     """
     _check_header(header)
     formats.stamp(file, FORMAT)
-    write_attrs(file, {**header, "version": __version__, "nstored": 0, "completed": False, "stop_reason": ""})
+    arithmetic = json.dumps([{"from_increment": 0, **decisive()}], sort_keys=True)
+    write_attrs(file, {**header, "version": __version__, "arithmetic": arithmetic, "nstored": 0, "completed": False,
+                       "stop_reason": ""})
     save_mesh(mesh, file.create_group("mesh"))
     delta_u, delta_eps, delta_target, delta_lever = linear_response
     event = file.create_group("event")
@@ -197,6 +203,32 @@ def rewrite(path, **attrs):
         with open_file(tmp, "w") as target:
             copy_file(source, target, rows=int(source.attrs["nstored"]))
             write_attrs(target, attrs)
+
+
+def check_arithmetic(path):
+    """Before a resume: the attributes that record this process's arithmetic, if it is not the stored one.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An incomplete simulation file.
+
+    Returns
+    -------
+    dict
+        ``{}`` if the arithmetic is the stored one, else ``{"arithmetic": ...}`` with a segment
+        appended (to pass to :func:`rewrite`).
+
+    Raises
+    ------
+    stickslip.arithmetic.ArithmeticMismatchError
+        If it differs and continuing anyway was not asked for (:func:`stickslip.arithmetic.check_resume`).
+    """
+    with open_file(path) as file:
+        _check(file)
+        stored, nstored = file.attrs.get("arithmetic", ""), int(file.attrs["nstored"])
+    text = check_resume(path, stored, nstored)
+    return {} if text is None else {"arithmetic": text}
 
 
 def _check(file):

@@ -15,8 +15,10 @@ file too damaged to open (a truncated copy) is moved aside, never deleted (:func
 """
 
 import errno
+import glob
 import json
 import os
+import re
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -26,6 +28,7 @@ import numpy as np
 from ..h5io import FileFormatError, open_file
 from .atomic import atomic_output
 from .errors import OutputError
+from .lock import writer_lock
 
 __all__ = ["OutputExistsError", "refuse_other_run", "claimed_output", "write_text_output", "set_aside",
            "OVERWRITE_HINT"]
@@ -42,8 +45,6 @@ _DESCRIBING = ("format", "solver", "solver_version", "analysis")
 #: How a message calls an item of the identity.
 _NAMES = {"params": "parameters"}
 
-#: Differences listed in a message at most.
-_SHOWN = 3
 
 _MISSING = object()
 
@@ -143,6 +144,23 @@ def _description(stored):
     return what
 
 
+def changed_values(stored, wanted):
+    """Every entry of two mappings that differs, as ``name = stored (this run: wanted)``, comma-separated.
+
+    Parameters
+    ----------
+    stored, wanted : Mapping[str, object]
+        E.g. a file's parameters and this run's (an entry absent from one shows as "(none)").
+
+    Returns
+    -------
+    str
+    """
+    changed = [name for name in {**stored, **wanted} if stored.get(name, _MISSING) != wanted.get(name, _MISSING)]
+    return ", ".join(f"{name} = {_show(stored.get(name, _MISSING))} (this run: {_show(wanted.get(name, _MISSING))})"
+                     for name in changed)
+
+
 def _difference(stored, identity, describe):
     """What ``stored`` holds against ``identity``, or None if it is the same run."""
     for key, expected in identity.items():
@@ -151,10 +169,7 @@ def _difference(stored, identity, describe):
             continue
         what = describe(stored)
         if isinstance(expected, dict) and isinstance(value, dict):
-            changed = [name for name in {**value, **expected} if value.get(name, _MISSING) != expected.get(name)]
-            listed = ", ".join(f"{name} = {_show(value.get(name, _MISSING))} (this run: "
-                               f"{_show(expected.get(name, _MISSING))})" for name in changed[:_SHOWN])
-            return f"holds {what} with other {_NAMES.get(key, key)}: {listed}{', ...' if len(changed) > _SHOWN else ''}"
+            return f"holds {what} with other {_NAMES.get(key, key)}: {changed_values(value, expected)}"
         if key in _DESCRIBING:
             return f"holds {what} (this run: {key} {_show(expected)})"
         return f"holds {what} with {key} = {_show(value)} (this run: {_show(expected)})"
@@ -207,15 +222,17 @@ def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe
 
 
 @contextmanager
-def claimed_output(path, identity, *, overwrite=False):
+def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
     """The one rule of the command line: write ``path`` in the block only if it is absent, this run, or ``overwrite``.
 
     Before the block: an absent output or one that holds this run (:func:`refuse_other_run`) is
     left to the writer (to write, resume or leave); an HDF5 file too damaged to open is moved
     aside to ``<name>.unreadable`` (with a message); another run is refused, unless ``overwrite``:
-    it is then moved aside to ``<name>.replaced`` until the block ends. If the block fails before
-    it has written ``path``, the replaced file is moved back; if it fails after, the replaced
-    file stays aside (the message says where); if it succeeds, the replaced file is deleted.
+    it is then moved aside to ``<name>.replaced`` until the block ends (never while another process
+    writes it: that is refused first). If the block fails before it has written ``path``, the
+    replaced file is moved back; if it fails after, the replaced file stays aside (the message says
+    where); if it succeeds, the replaced file is deleted, and so is one left aside by an earlier
+    ``--overwrite`` whose new run was interrupted and has now been completed (with a message).
 
     Parameters
     ----------
@@ -224,6 +241,8 @@ def claimed_output(path, identity, *, overwrite=False):
         Root attributes of the file this run writes (see the module docstring).
     overwrite : bool, optional
         Replace another run (``--overwrite``).
+    hint : str, optional
+        The end of the refusal's message: how to overwrite (default: the command line's ``--overwrite``).
 
     Raises
     ------
@@ -236,11 +255,12 @@ def claimed_output(path, identity, *, overwrite=False):
         print(f"stickslip: {path}: not a readable HDF5 file; moved it to {aside}, starting the run over",
               file=sys.stderr)
     try:
-        refuse_other_run(path, identity)
+        refuse_other_run(path, identity, hint=hint)
     except OutputExistsError as error:
         if not overwrite:
             raise
-        replaced = set_aside(path, "replaced")
+        with writer_lock(path):  # another process writing it: refused before anything is moved
+            replaced = set_aside(path, "replaced")
         print(f"stickslip: {path}: {error.difference}; --overwrite: moved it to {replaced} until the new output "
               f"is complete", file=sys.stderr)
     else:
@@ -256,6 +276,16 @@ def claimed_output(path, identity, *, overwrite=False):
         raise
     if replaced is not None:
         replaced.unlink()
+    for earlier in _replaced_earlier(path):
+        earlier.unlink()
+        print(f"stickslip: {path} is complete: removed {earlier}, the run it replaced (an earlier --overwrite)",
+              file=sys.stderr)
+
+
+def _replaced_earlier(path):
+    """Files that an earlier ``--overwrite`` of ``path`` set aside (``<name>.replaced[-<k>]``)."""
+    pattern = re.compile(re.escape(path.name) + r"\.replaced(-\d+)?")
+    return sorted(p for p in path.parent.glob(glob.escape(path.name) + ".replaced*") if pattern.fullmatch(p.name))
 
 
 def write_text_output(path, text, *, overwrite=False):

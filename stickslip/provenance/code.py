@@ -6,7 +6,11 @@ rule, so that Snakemake reruns exactly the jobs whose code changed: a change in
 the ``lever`` ones. The hash covers the plugin's module and every module of the
 package that it imports, directly or through other package modules (found by
 reading the import statements, without importing anything), plus the
-``__init__.py`` of every package on the way (they run on import).
+``__init__.py`` of every package on the way (they run on import). The imports of the package's own
+``stickslip/__init__.py`` are not followed (its file is hashed): it binds the public API
+(:mod:`stickslip.api`) for notebooks and scripts, which no plugin runs, and following it would put
+that API's modules (the analyses' readers, the database's queries) into every plugin's hash, so that
+an edit of the event extraction would rerun the ``fem`` simulations.
 
 Imports made by name at run time (``importlib.import_module("...")``) are not
 seen; plugins do not use them. A third-party plugin (a module outside the
@@ -105,6 +109,8 @@ def module_sources(module):
         seen[path] = name
         for init in _package_inits(name):
             pending.append((init.parent.relative_to(ROOT.parent).as_posix().replace("/", "."), init))
+        if path == ROOT / "__init__.py":
+            continue  # the public API's imports: see the module's docstring
         for imported in _imported_names(path, name):
             source = _module_file(imported)
             if source is not None:

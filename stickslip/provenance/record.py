@@ -2,7 +2,8 @@
 
 A record says what made a file and how: the plugin and its version, the code
 hash, the package version and git commit, every parameter, the seed, the
-library versions, the host, the start and end time, the wall time, the peak
+library versions, the host and its arithmetic (CPU, BLAS kernel, numba target:
+:mod:`stickslip.arithmetic`), the start and end time, the wall time, the peak
 memory, and the inputs and outputs with their sha256. It is written under a
 temporary name and renamed into place, so a reader never sees half a record.
 
@@ -22,6 +23,7 @@ from contextlib import contextmanager
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
+from ..arithmetic import decisive, host
 from ..h5io import FileFormatError
 from ..hashing import sha256_file
 from ..lineage import Artifact
@@ -39,7 +41,8 @@ REQUIRED_FIELDS = ("schema_version", "run_id", "kind", "plugin", "plugin_version
                    "package_version", "git_commit", "git_dirty", "params", "seed", "threads",
                    "versions", "host", "start", "end", "wall_time_s", "peak_memory_mib", "inputs", "outputs")
 
-LIBRARIES = ("numpy", "numba", "h5py", "pandas", "matplotlib", "sqlalchemy", "snakemake")
+LIBRARIES = ("numpy", "scipy", "numba", "llvmlite", "qdldl", "threadpoolctl", "h5py", "pandas", "matplotlib",
+             "sqlalchemy", "snakemake")
 
 
 def record_path(output):
@@ -205,6 +208,7 @@ def _job_record(*, run_id, kind, plugin, plugin_version, code_hash, params, thre
         "plugin_version": plugin_version, "code_hash": code_hash, "package_version": _package_version(),
         "git_commit": commit, "git_dirty": dirty, "params": params, "seed": params.get("seed"),
         "threads": threads, "versions": library_versions(), "host": socket.gethostname(),
+        "arithmetic": {"decisive": decisive(), "host": host()},
         "inputs": [_input_entry(role, path) for role, path in inputs],
     }
 

@@ -31,7 +31,7 @@ from ..params import ParameterError, param, params_to_dict
 
 __all__ = ["LeverParams", "run", "check_protocol", "VERSION"]
 
-VERSION = "1"
+VERSION = "2"  # 2: coupling products and solves in a fixed order (host-independent bits)
 
 #: Per-interface parameters: one value for every interface, or one per interface.
 PER_INTERFACE = ("mu_d", "B", "creep_velocity")

@@ -31,7 +31,7 @@ from .lever import LeverParams, check_protocol
 
 __all__ = ["RateStateLeverParams", "run", "VERSION"]
 
-VERSION = "3"  # 2: RODAS4 with relative slip-rate tolerances (issue 12); 3: the friction as state (issue 24)
+VERSION = "4"  # 4: coupling matrices in a fixed order (host-independent bits); 2: RODAS4 with relative slip-rate tolerances (issue 12); 3: the friction as state (issue 24)
 
 #: Parameters shared with the ``lever`` solver: apparatus, protocol, drive, sensors.
 SHARED = ("n", "protocol", "a", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",

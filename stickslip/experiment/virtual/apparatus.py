@@ -26,6 +26,8 @@ import dataclasses
 
 import numpy as np
 
+from ...fixed_order import dot, solve
+
 __all__ = ["Apparatus"]
 
 
@@ -142,7 +144,7 @@ class Apparatus:
 
     def lever_force(self, f):
         """Moment balance: F = sum_j f_j j h / H [N], shape [...] from forces [..., n_slabs] [N]."""
-        return f @ self.heights / self.H
+        return dot(f, self.heights) / self.H
 
     def mu(self, t, R):
         """Friction coefficients of every interface at time ``t`` [s] and slips ``R`` [n_slabs] [mm]."""
@@ -182,5 +184,5 @@ class Apparatus:
         R = np.zeros(self.n_slabs)
         unloaded = self.mu(0.0, R)
         coupling = self.coupling()[np.ix_(index, index)]
-        R[index] = np.linalg.solve(coupling, unloaded[index] - np.asarray(mu_target)[index])
+        R[index] = solve(coupling, unloaded[index] - np.asarray(mu_target)[index])
         return R

@@ -26,6 +26,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from ...fixed_order import dot, solve
 from ...progress import bar
 from .friction import first_crossing
 
@@ -84,7 +85,7 @@ def _slip_group(C, mu, target_mu, group):
     """
     group = list(group)
     while True:
-        dR = np.linalg.solve(C[np.ix_(group, group)], mu[group] - target_mu[group])
+        dR = solve(C[np.ix_(group, group)], mu[group] - target_mu[group])
         if np.all(dR > 0.0) or len(group) == 1:
             return group, dR
         if dR[0] <= 0.0:
@@ -154,8 +155,8 @@ def integrate(apparatus, law, duration, slip_duration, rng):
 
     while t < duration:
         velocity = np.where(creeping, law.creep_velocity, 0.0)
-        rates = (drive_rates - C @ velocity).tolist()
-        mu = (unloaded + drive_rates * t - C @ R).tolist()
+        rates = (drive_rates - dot(C, velocity)).tolist()
+        mu = (unloaded + drive_rates * t - dot(C, R)).tolist()
         tau, kind, which = duration - t, "end", -1
         for i in slippable:
             T = t - float(onset[i])
@@ -178,11 +179,11 @@ def integrate(apparatus, law, duration, slip_duration, rng):
             creep_start[which] = t
             continue
         stop_creep(t)
-        mu = unloaded + drive_rates * t - C @ R
+        mu = unloaded + drive_rates * t - dot(C, R)
         gap = law.strength(t - onset, excess) - mu
         group = [which] + [i for i in slippable if i != which and gap[i] < law.trigger_margin]
         group, dR = _slip_group(C, mu, law.mu_d, group)
-        mu_after = mu - C[:, group] @ dR
+        mu_after = mu - dot(C[:, group], dR)
         for i, d in sorted(zip(group, dR)):
             rows.append((event, t, t + slip_duration, i + 1, d, d * force_per_slip[i], mu[i] - mu_after[i],
                          mu[i], mu_after[i], t - onset[i] if has_slipped[i] else math.nan, t - onset[i],

@@ -36,6 +36,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ... import progress
+from ...fixed_order import dot, inverse
 from . import rosenbrock
 from .slab_equations import jacobian as _jacobian, rhs as _rhs, slip_rates as _slip_rates
 from .slip_path import no_path
@@ -133,11 +134,11 @@ class SlabDynamics:
                 n_driven[body_of_slab[j]] += 1
         lower = np.tril(np.ones((m, m)))
         stiffness = K * n_driven[:, None] * lower
-        difference = np.linalg.inv(lower)               # V = D u
+        difference = inverse(lower)               # V = D u
         reaction = np.eye(m) - np.eye(m, k=1)           # friction of interface k minus that of k + 1
         inverse_mass = MM_PER_M / self.masses
         accel = difference * inverse_mass[None, :]      # D M^-1 [mm/s^2 per N]
-        return accel @ drive, accel @ stiffness, accel @ (self.apparatus.normal_force * reaction)
+        return dot(accel, drive), dot(accel, stiffness), dot(accel, self.apparatus.normal_force * reaction)
 
     def __post_init__(self):
         drive, stiffness, coupling = self._matrices()
@@ -179,8 +180,8 @@ class SlabDynamics:
         coupling mu`` [mm/s^2], of states ``y`` [..., 3 m + 1], [..., m]."""
         y = np.asarray(y, dtype=float)
         m = self._a.size
-        return (y[..., 3 * m:] * self._drive - y[..., :m] @ self._stiffness.T
-                - y[..., m:2 * m] @ self._coupling.T)
+        return (y[..., 3 * m:] * self._drive - dot(y[..., :m], self._stiffness.T)
+                - dot(y[..., m:2 * m], self._coupling.T))
 
     def rhs(self, y, rate):
         """dy/dt of the state ``y = [R, mu, psi, gamma]`` [3 m + 1] with the lever turning at ``rate`` [1/s]."""

@@ -1,0 +1,63 @@
+"""One solver run under the command line's rules: ``stickslip simulate`` and :func:`stickslip.simulate`.
+
+The parameters are validated with the plugin's dataclass (the message names the parameter and what
+was expected), the output is checked writable before any work, and an existing output is claimed
+by the one rule of every command that writes a file (:func:`stickslip.output_safety.overwrite.claimed_output`):
+the same run is resumed (``fem``) or written again, another run is refused unless ``overwrite``.
+"""
+
+from . import registry
+from .numba_options import set_num_threads
+from .output_safety.atomic import check_output
+from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
+from .params import params_to_dict, parse_params
+
+__all__ = ["run_identity", "run_solver"]
+
+
+def run_identity(plugin, params):
+    """What a solver's output file stores about its run (root attributes): format, solver, version, parameters."""
+    return {"format": plugin.produces, "solver": plugin.name, "solver_version": plugin.version,
+            "params": params_to_dict(params)}
+
+
+def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_hint=OVERWRITE_HINT):
+    """Validate the parameters and the output, then run one solver into ``output``.
+
+    Parameters
+    ----------
+    solver : str
+        Solver plugin name (``stickslip plugins``).
+    output : str or pathlib.Path
+        The output file (HDF5): written, or resumed if it holds this run unfinished (``fem``).
+    values : Mapping[str, object]
+        Parameters by name, as values or as the command line's strings; the others keep their defaults.
+    threads : int, optional
+        Threads of the parallel kernels (>= 1; at most what numba was started with).
+    overwrite : bool, optional
+        Replace an output that holds another run (kept aside until the new one is complete).
+    overwrite_hint : str, optional
+        The end of the message that refuses another run's output: how to overwrite it (the command
+        line's ``--overwrite`` by default).
+
+    Returns
+    -------
+    registry.Plugin, object
+        The solver and its validated parameters.
+
+    Raises
+    ------
+    stickslip.registry.PluginError
+        If there is no such solver.
+    stickslip.params.ParameterError
+        For an unknown parameter or a bad value (a ``ValueError`` naming the parameter).
+    stickslip.output_safety.errors.OutputError
+        If ``output`` cannot be written, or holds another run and ``overwrite`` is false.
+    """
+    plugin = registry.get("solver", solver)
+    params = parse_params(plugin.params, values, owner=f"solver '{plugin.name}'")
+    used = set_num_threads(threads)
+    check_output(output)
+    with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint):
+        plugin.run(params, output, threads=used, inputs={})
+    return plugin, params
