@@ -70,8 +70,8 @@ SIZES = ({"big": 18, "mid": 9, "steps": 8, "launch": 4, "events": 0, "big_events
           "reference_increments": 1, "relaxation": "exact", "quiet_steps": 4, "alone_groups": (1,),
           "batches": (2,), "batch_increments": 1}
          if SMOKE else
-         {"big": 1458, "mid": 162, "steps": 8192, "launch": STEPS_PER_LAUNCH, "events": 8, "big_events": 3,
-          "increments": 400, "seeds": 6, "reference_increments": 0, "relaxation": "dynamic", "quiet_steps": 0,
+         {"big": 1458, "mid": 162, "steps": 8192, "launch": STEPS_PER_LAUNCH, "events": 8, "big_events": 2,
+          "increments": 300, "seeds": 6, "reference_increments": 0, "relaxation": "dynamic", "quiet_steps": 0,
           "alone_groups": None, "batches": (8, 32, 128), "batch_increments": 24})
 
 
@@ -374,8 +374,8 @@ def part_compare(out):
 
 #: The GPU parts in order, each with its time limit [s]: run in one process (the kernels compile once),
 #: a part that ended (or was started and never ended: a crash or a hang) is not run again.
-GPU_PARTS = (("env", part_env, 60), ("sanity", part_sanity, 150), ("fidelity", part_fidelity, 200),
-             ("speed", part_speed, 150), ("events", part_events, 150), ("ensemble", part_ensemble, 200))
+GPU_PARTS = (("env", part_env, 60), ("sanity", part_sanity, 100), ("fidelity", part_fidelity, 150),
+             ("speed", part_speed, 150), ("events", part_events, 120), ("ensemble", part_ensemble, 150))
 
 PARTS = {"cpu-step": part_cpu_step, "cpu-events": part_cpu_events, "compare": part_compare}
 

@@ -35,7 +35,7 @@ def _why_not():
     if importlib.util.find_spec("numba_cuda") is None:
         return "numba-cuda is not installed; install the GPU extra: pip install stickslip[gpu]"
     from numba import cuda  # numba-cuda's target (numba's own is deprecated)
-    from numba.cuda import config
+    from numba import config
 
     if config.ENABLE_CUDASIM:
         return ""

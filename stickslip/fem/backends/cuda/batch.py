@@ -15,7 +15,7 @@ import weakref
 
 import numpy as np
 from numba import cuda
-from numba.cuda import config
+from numba import config  # ENABLE_CUDASIM: numba-cuda reads the same variable
 
 from ..base import MAX_ITER_REACHED
 from .kernels import EVENTS_FULL, MAX_LAYERS, RUNNING, kernels_for
