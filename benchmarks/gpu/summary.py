@@ -9,7 +9,8 @@ def main(out):
     records = [json.loads(line) for line in (Path(out) / "results.jsonl").read_text().splitlines() if line.strip()]
     by = {}
     for record in records:
-        by.setdefault(record.get("part"), []).append(record)
+        if "error" not in record:
+            by.setdefault(record.get("part"), []).append(record)
     for record in by.get("env", []):
         print(f"GPU {record['gpu']} (cc {record['compute_capability']}, {record['sm_count']} SMs; {record['nvidia_smi']}),"
               f" CPU {record['cpu']} x {record['cpus']}, Python {record['python']}, numba {record['numba']}, "

@@ -23,6 +23,7 @@ plain work items of :mod:`.items` (:func:`kernels_for`).
 
 import functools
 
+import numpy as np
 from numba import cuda, float64, int64
 
 from ..base import CONVERGED, MARGIN, MAX_ITER_REACHED, QUIET
@@ -40,7 +41,12 @@ EVENTS_FULL = 4
 MAX_LAYERS = 11
 
 _L = LEAVES
-_ROWS = MAX_LAYERS + 2  # the tree's rows: the layers' averages, then the residual's two norms
+_ROWS = MAX_LAYERS + 2
+
+if not hasattr(np, "row_stack"):
+    # numba-cuda 0.30.4 overloads np.row_stack when its numpy support loads (at the first compilation); NumPy 2.5
+    # removed that alias of np.vstack, and the compilation then fails (seen on the GPU machine's numpy 2.5.2)
+    np.row_stack = np.vstack  # the tree's rows: the layers' averages, then the residual's two norms
 
 
 def _device(function):
