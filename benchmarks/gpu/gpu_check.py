@@ -117,11 +117,11 @@ def part_env(out):
     cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
                 if line.startswith("model name")), platform.processor())
     versions = {}
-    for name in ("numpy", "numba", "numba_cuda", "llvmlite", "scipy", "h5py", "pandas"):
+    for package in ("numpy", "numba", "numba_cuda", "llvmlite", "scipy", "h5py", "pandas"):
         try:
-            versions[name] = __import__(name).__version__
+            versions[package] = __import__(package).__version__
         except Exception as error:  # reported, not fatal
-            versions[name] = repr(error)
+            versions[package] = repr(error)
     emit(out, part="env", gpu=name.decode() if isinstance(name, bytes) else str(name),
          compute_capability=list(getattr(device, "compute_capability", (0, 0))),
          sm_count=getattr(device, "MULTIPROCESSOR_COUNT", 1),
