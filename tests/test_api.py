@@ -16,7 +16,7 @@ import stickslip
 from stickslip import registry
 from stickslip.cli import main
 from stickslip.events.results import read_analysis_file
-from stickslip.formats import fem_run
+from stickslip.formats import fem_run, get_format
 from stickslip.h5io import FileFormatError, UnreadableFileError, read_table
 from stickslip.lineage import Artifact
 from stickslip.mesh import interface_layer
@@ -183,7 +183,8 @@ def test_a_file_of_another_format_is_the_readers_error_naming_it(tmp_path):
     mesh = tmp_path / "mesh.h5"
     assert _cli("mesh", "--param", "N=9", "--param", "plates=2", "-o", mesh)[0] == 0
     with pytest.raises(FileFormatError, match=f"{mesh}: a mesh file version 1, expected a simulation file: "
-                                              "fem-run version 1, timeseries version 1"):
+                                              f"fem-run version {get_format('fem-run').version}, timeseries "
+                                              f"version {get_format('timeseries').version}"):
         stickslip.open_run(mesh)
     text = tmp_path / "notes.txt"
     text.write_text("not HDF5")
@@ -199,8 +200,9 @@ def test_a_file_of_another_format_is_the_readers_error_naming_it(tmp_path):
 def test_simulate_never_replaces_another_run_unless_told(tmp_path):
     lab = _lever_file(tmp_path)
     before = _sha256(lab)
-    with pytest.raises(OutputExistsError, match=f"{lab}: holds a timeseries file of solver lever 1 with other "
-                                                "parameters: seed = 1 \\(this run: 2\\); pass overwrite=True"):
+    version = registry.get("solver", "lever").version
+    with pytest.raises(OutputExistsError, match=f"{lab}: holds a timeseries file of solver lever {version} with "
+                                                "other parameters: seed = 1 \\(this run: 2\\); pass overwrite=True"):
         stickslip.simulate("lever", lab, n=1, seed=2, duration=400.0)
     assert _sha256(lab) == before
     again = stickslip.simulate("lever", lab, n=1, seed=1, duration=400.0)  # the same run: written again
