@@ -210,6 +210,8 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         from .numba_options import set_num_threads
 
         plugin, params = _load("solver", solver, params_json, module)
+        if plugin.preflight is not None:  # e.g. a GPU backend without a GPU: said before any file is touched
+            plugin.preflight(params)
         run_id, code = registry.run_id(plugin, params), code_hash(plugin.module)
         output, partial = Path(output), partial_path(output)
         _refuse_other_outputs([output], record, run_id)

@@ -208,3 +208,22 @@ def test_a_thermal_increment_draws_the_same_event_on_the_device(simulated):
 def test_a_batch_member_equals_the_same_realisation_run_alone_bit_for_bit(simulated):
     assert simulated["batch"]["status"] == [[-1, 3], [-1, 5], [-1, 2]]
     assert simulated["batch"]["equal"] == [True, True, True]
+
+
+def test_the_cuda_backend_without_a_gpu_is_one_line_before_any_file_is_touched(tmp_path, capsys):
+    from stickslip.cli import main
+    from stickslip.fem.backends.cuda import CudaBackend
+
+    if not CudaBackend.unavailable():
+        pytest.skip("a GPU is available here")
+    output = tmp_path / "run.h5"
+    assert main(["simulate", "--solver", "fem", "--param", "N=9", "--param", "backend=cuda", "-o", str(output)]) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.startswith("stickslip: error: parameter 'backend': 'cuda' cannot run on this machine: ")
+    assert len(error.splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+    # another run's file is left as it is, even with --overwrite
+    output.write_bytes(b"another run")
+    assert main(["simulate", "--solver", "fem", "--param", "N=9", "--param", "backend=cuda", "--overwrite", "-o",
+                 str(output)]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"] and output.read_bytes() == b"another run"

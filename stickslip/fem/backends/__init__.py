@@ -10,6 +10,7 @@ run file and its id). A new backend: one module and :func:`register_backend` (do
 "A new backend").
 """
 
+from ...params import ParameterError
 from .base import CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend
 from .cpu import AssembledBackend, StructuredBackend
 from .cuda import CudaBackend
@@ -42,12 +43,13 @@ def make_backend(name=DEFAULT_BACKEND, threads=1):
 
     Raises
     ------
-    ValueError
-        If no backend of that name is registered, or it cannot run on this machine (the reason).
+    stickslip.params.ParameterError
+        If no backend of that name is registered, or it cannot run on this machine (the message says why).
     """
     if name not in BACKENDS:
-        raise ValueError(f"backend {name!r}: expected one of {', '.join(sorted(BACKENDS))}")
+        raise ParameterError(f"parameter 'backend': {name!r} is not a backend; expected one of "
+                             f"{', '.join(sorted(BACKENDS))}")
     reason = BACKENDS[name].unavailable()
     if reason:
-        raise ValueError(f"backend {name!r} cannot run here: {reason}")
+        raise ParameterError(f"parameter 'backend': {name!r} cannot run on this machine: {reason}")
     return BACKENDS[name](threads=threads)
