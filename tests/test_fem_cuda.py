@@ -162,7 +162,8 @@ def simulated(numba_cuda):
     steps = {1: 3, 2: 5, 3: 2}
 
     def run(seed, backend):
-        sim = Simulation(FemParams(N=9, plates=2, seed=seed, dt_scale=4.0, backend="cuda"), mesh, backend)
+        sim = Simulation(FemParams(N=9, plates=2, seed=seed, dt_scale=4.0, relaxation="exact", backend="cuda"), mesh,
+                         backend)  # exact: the linear response by one solve (the simulator is slow)
         sim.loading.step(False)
         sim.loading.step(True)
         status = sim.stack.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
@@ -227,3 +228,50 @@ def test_the_cuda_backend_without_a_gpu_is_one_line_before_any_file_is_touched(t
     assert main(["simulate", "--solver", "fem", "--param", "N=9", "--param", "backend=cuda", "--overwrite", "-o",
                  str(output)]) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"] and output.read_bytes() == b"another run"
+
+
+GPU_STUDY = """
+gpu_batch: 2
+solvers:
+  fem:
+    - params: {N: 9, max_increments: 1, backend: cuda, relaxation: exact}  # the linear response by one solve
+      grid:
+        plates: [2]
+        seed: [1, 2, 3]
+    - params: {N: 9, max_increments: 1}
+      grid:
+        plates: [2]
+        seed: [1]
+analyses:
+  numerical-events: {}
+figures: {}
+"""
+
+
+def test_a_gpu_batch_is_one_job_that_writes_every_run_s_usual_file(numba_cuda, tmp_path):
+    # three runs of fem on the GPU in batches of at most 2 (one job each), beside a CPU run; on the simulator, one
+    # load increment each: the files, records and database rows are the usual ones
+    from conftest import copy_workflow
+    from test_workflow import planned_jobs, snakemake
+
+    directory = copy_workflow(tmp_path)
+    (directory / "gpu.yaml").write_text(GPU_STUDY)
+    planned = planned_jobs(snakemake(directory, "-n", "--cores", "2", "--configfile", "gpu.yaml").stdout)
+    assert planned["simulate"] == 1 and sum(v for k, v in planned.items() if k.startswith("simulate_batch_")) == 2
+    os.environ["NUMBA_ENABLE_CUDASIM"] = "1"  # read by the jobs (numba-cuda's simulator)
+    try:
+        snakemake(directory, "--cores", "2", "--configfile", "gpu.yaml")
+    finally:
+        del os.environ["NUMBA_ENABLE_CUDASIM"]
+    results = directory / "results" / "gpu"
+    runs = sorted((results / "sim" / "fem").glob("*.h5"))
+    assert len(runs) == 4 and all(run.with_suffix(".provenance.json").is_file() for run in runs)
+    logs = sorted(p.name for p in (results / "logs" / "sim" / "fem").glob("batch-*.log"))
+    assert len(logs) == 2
+    import sqlite3
+
+    with sqlite3.connect(results / "stickslip.sqlite") as db:
+        backends = sorted(json.loads(params).get("backend", "structured")
+                          for (params,) in db.execute("SELECT r.params FROM runs AS r JOIN simulations AS s "
+                                                      "ON s.run_id = r.run_id"))
+    assert backends == ["cuda", "cuda", "cuda", "structured"]

@@ -57,7 +57,11 @@ def can_run(params):
 
 @registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay,
                    preflight=can_run)
-def run(params, output, *, threads=1, inputs=None):
-    """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
-    run_simulation(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
+def run(params, output, *, threads=1, inputs=None, backend=None):
+    """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics.
+
+    ``backend``: a backend object of ``params.backend`` to run on (a GPU batch's,
+    :func:`stickslip.workflow_api.run_simulation_batch`); default: a new one.
+    """
+    run_simulation(params, output, stack_mesh(params, inputs), backend or make_backend(params.backend, threads),
                    producer=("fem", VERSION))
