@@ -72,14 +72,17 @@ PRELUDE = """
         return out
 """
 
-#: Relative difference allowed between the device's and the CPU's arrays after a few steps: round-off of
-#: other summation orders and of fused multiply-adds, amplified by a few time steps.
-ROUND_OFF = 1e-11
+#: Relative difference allowed between the device's and the CPU's arrays (to their largest entry) after a force
+#: evaluation: round-off of other summation orders.
+EVALUATION = 1e-12
+#: The same after a few time steps: that round-off grown by the dynamics (a layer's average enters the drive as
+#: ``ubar - target``, a difference of nearly equal numbers; a block sheared ten wells ahead moves violently).
+ROUND_OFF = 1e-9
 
 
-def _close(differences):
+def _close(differences, tolerance=ROUND_OFF):
     assert differences.pop("idx"), "the wells differ"
-    assert all(value < ROUND_OFF for value in differences.values()), differences
+    assert all(value < tolerance for value in differences.values()), differences
 
 
 def test_every_kernel_compiles_for_the_h100_and_uses_no_floating_point_atomics(numba_cuda):
@@ -180,8 +183,8 @@ def simulated(numba_cuda):
 
 def test_the_force_evaluation_and_time_steps_after_a_kick_equal_the_cpu(simulated):
     for drive in ("fixed-lever", "free-lever"):
-        for stage in ("origin", "kick", "steps"):
-            _close(dict(simulated[f"{drive}:{stage}"]))
+        for stage, tolerance in (("origin", EVALUATION), ("kick", EVALUATION), ("steps", ROUND_OFF)):
+            _close(dict(simulated[f"{drive}:{stage}"]), tolerance)
         assert simulated[f"{drive}:residual"] < ROUND_OFF
 
 
