@@ -278,3 +278,44 @@ def test_a_gpu_batch_is_one_job_that_writes_every_run_s_usual_file(numba_cuda, t
                           for (params,) in db.execute("SELECT r.params FROM runs AS r JOIN simulations AS s "
                                                       "ON s.run_id = r.run_id"))
     assert backends == ["cuda", "cuda", "cuda", "structured"]
+
+
+def test_runs_minimising_in_different_batches_at_once_meet_in_one_round(numba_cuda):
+    # two runs of an ensemble: one in the batch of its interface law, one in the batch of the elastic law (its linear
+    # response) at the same time; and a third that leaves while the others wait (its run ended)
+    result = _run("""
+    import threading
+    from stickslip.fem.backends.cuda.batch import Ensemble
+
+    class Batch:
+        def __init__(self, name):
+            self.name, self.launches = name, []
+
+        def launch(self, slots):
+            self.launches.append(slots)
+            return {slot: (1, 10 * slot) for slot in slots}
+
+    ensemble, cusp, elastic = Ensemble(3), Batch("cusp"), Batch("elastic")
+    results, ready = {}, threading.Barrier(3)
+
+    def run(name, batch, slot):
+        ensemble.join()
+        ready.wait()
+        if batch is None:
+            ensemble.leave()
+            return
+        results[name] = ensemble.meet(batch, slot)
+        ensemble.leave()
+
+    threads = [threading.Thread(target=run, args=args, daemon=True)
+               for args in (("a", cusp, 0), ("b", elastic, 3), ("c", None, None))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=60)
+    print(json.dumps({"alive": [thread.is_alive() for thread in threads], "results": results,
+                      "launches": [cusp.launches, elastic.launches]}))
+    """)
+    assert result["alive"] == [False, False, False]  # no run waits for another in another batch
+    assert result["results"] == {"a": [1, 0], "b": [1, 30]}
+    assert result["launches"] == [[[0]], [[3]]]  # one launch per batch in the round

@@ -234,11 +234,11 @@ def _speed(out, plates, sizes, groups_alone, steps):
         slots = [member.slot for member in members]
         for slot in slots:
             batch._begin(slot, 0.0, 1, 10 ** 9, 0, False, 0)
-        batch._launch(slots)  # warm up (compiles on the first launch)
+        batch.launch(slots)  # warm up (compiles on the first launch)
         start = time.perf_counter()
         rounds = max(1, steps // SIZES["launch"])
         for _ in range(rounds):
-            batch._launch(slots)
+            batch.launch(slots)
         seconds = time.perf_counter() - start
         per_step = seconds / (rounds * SIZES["launch"])
         emit(out, part="speed", N=N, plates=plates, elements=nelem, dofs=model.ndof, batch=count,

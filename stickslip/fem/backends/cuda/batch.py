@@ -143,10 +143,6 @@ class DeviceBatch:
         self.events = zeros((B, 1, 3))
         self._slots = list(range(B))
         self._lock = threading.Lock()
-        self._round = threading.Condition()
-        self._waiting = {}
-        self._results = {}
-        self._generation = 0
 
     # --- slots ---------------------------------------------------------------------------------
 
@@ -344,7 +340,7 @@ class DeviceBatch:
         """Blocks per realisation for a launch of ``count`` realisations (all co-resident: at most one block per SM)."""
         return max(1, min(self._groups_cap(), self.mesh.sm_count // count))
 
-    def _launch(self, slots):
+    def launch(self, slots):
         """One launch of the minimisation kernel for ``slots``; their (status, steps) afterwards."""
         G = self._groups(len(slots))
         with LAUNCHES:
@@ -355,31 +351,11 @@ class DeviceBatch:
         return {slot: (int(status[slot]), int(steps[slot])) for slot in slots}
 
     def _run_round(self, slot):
-        """Launch the slot's next round, together with every participant waiting for one."""
+        """Launch the slot's next round: alone, or with the ensemble's runs (:meth:`Ensemble.meet`)."""
         ensemble = self.participants
         if ensemble is None or not ensemble.includes(threading.get_ident()):
-            return self._launch([slot])[slot]
-        with self._round:
-            self._waiting[slot] = threading.get_ident()
-            generation = self._generation
-            if len(self._waiting) >= ensemble.active():
-                self._results = self._launch(sorted(self._waiting))
-                self._waiting = {}
-                self._generation += 1
-                self._round.notify_all()
-            else:
-                while self._generation == generation:
-                    self._round.wait()
-            return self._results[slot]
-
-    def wake(self):
-        """A participant left: launch the waiting slots if every remaining participant waits."""
-        with self._round:
-            if self._waiting and len(self._waiting) >= self.participants.active():
-                self._results = self._launch(sorted(self._waiting))
-                self._waiting = {}
-                self._generation += 1
-                self._round.notify_all()
+            return self.launch([slot])[slot]
+        return ensemble.meet(self, slot)
 
 
 class Ensemble:
@@ -400,6 +376,10 @@ class Ensemble:
         self._lock = threading.Lock()
         self._batches = []
         self.mesh = None
+        self._round = threading.Condition()
+        self._waiting = {}  # batch -> its slots waiting for the next round
+        self._results = {}
+        self._generation = 0
 
     def join(self):
         """Register the calling thread as a run of the ensemble."""
@@ -410,9 +390,48 @@ class Ensemble:
         """The calling thread's run ended (however): the others no longer wait for it."""
         with self._lock:
             self._threads.discard(threading.get_ident())
-            batches = list(self._batches)
-        for batch in batches:
-            batch.wake()
+        with self._round:
+            if self._waiting and self._everyone_waits():
+                self._launch_round()
+
+    def meet(self, batch, slot):
+        """Wait until every run of the ensemble waits for a minimisation round, then launch each batch's waiting slots.
+
+        A run waits in the batch of the law it minimises at that moment (the elastic law of a linear response, the
+        interface law of an event): the round starts when the waiting runs, summed over the batches, are all the
+        runs still going, so runs that are in different batches at the same time do not wait for each other.
+
+        Parameters
+        ----------
+        batch : DeviceBatch
+        slot : int
+            The calling run's slot in ``batch``.
+
+        Returns
+        -------
+        (int, int)
+            The slot's status word and its time steps after the launch.
+        """
+        with self._round:
+            self._waiting.setdefault(batch, []).append(slot)
+            generation = self._generation
+            if self._everyone_waits():
+                self._launch_round()
+            else:
+                while self._generation == generation:
+                    self._round.wait()
+            return self._results[batch, slot]
+
+    def _everyone_waits(self):
+        return sum(map(len, self._waiting.values())) >= self.active()
+
+    def _launch_round(self):
+        """One launch per batch with waiting slots; wake the waiting runs (called holding ``_round``)."""
+        self._results = {(batch, slot): result for batch, slots in self._waiting.items()
+                         for slot, result in batch.launch(sorted(slots)).items()}
+        self._waiting = {}
+        self._generation += 1
+        self._round.notify_all()
 
     def includes(self, ident):
         """Whether thread ``ident`` is a run of the ensemble."""
