@@ -114,6 +114,9 @@ class Plugin:
         Figures: the input categories, each ``"analysis:<name>"`` or ``"format:<name>"``.
     replay : Callable or None
         Solvers: ``replay(path)`` re-runs stored events of a file the solver wrote.
+    preflight : Callable or None
+        Solvers: ``preflight(params)`` raises :class:`stickslip.params.ParameterError` if this machine cannot
+        make the run (e.g. a GPU backend without a GPU); called before any output is claimed or written.
     module : str
         Module that defined it.
     """
@@ -128,6 +131,7 @@ class Plugin:
     produces: str | None = None
     inputs: tuple = ()
     replay: Callable | None = None
+    preflight: Callable | None = None
     module: str = ""
 
 
@@ -182,7 +186,8 @@ def _check_contract(plugin):
         raise PluginError(f"{where}: replay must be a callable of a solver")
 
 
-def register(kind, name, version, params, *, summary="", consumes=(), produces=None, inputs=(), replay=None):
+def register(kind, name, version, params, *, summary="", consumes=(), produces=None, inputs=(), replay=None,
+             preflight=None):
     """Decorator that registers a plugin function.
 
     Parameters
@@ -196,7 +201,7 @@ def register(kind, name, version, params, *, summary="", consumes=(), produces=N
         Parameter dataclass.
     summary : str, optional
         One line for listings; defaults to the first line of the docstring.
-    consumes, produces, inputs, replay
+    consumes, produces, inputs, replay, preflight
         The plugin's contract (see :class:`Plugin`).
 
     Returns
@@ -214,7 +219,7 @@ def register(kind, name, version, params, *, summary="", consumes=(), produces=N
         doc = (inspect.getdoc(function) or "").strip().splitlines()
         plugin = Plugin(kind=kind, name=name, version=version, params=params, run=function,
                         summary=summary or (doc[0] if doc else ""), consumes=tuple(consumes), produces=produces,
-                        inputs=tuple(inputs), replay=replay, module=function.__module__)
+                        inputs=tuple(inputs), replay=replay, preflight=preflight, module=function.__module__)
         _check_shape(plugin)
         existing = _plugins[kind].get(name)
         if existing is not None and (existing.module, existing.run.__qualname__) != (

@@ -50,12 +50,15 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     stickslip.registry.PluginError
         If there is no such solver.
     stickslip.params.ParameterError
-        For an unknown parameter or a bad value (a ``ValueError`` naming the parameter).
+        For an unknown parameter or a bad value (a ``ValueError`` naming the parameter), or parameters this
+        machine cannot run (the solver's ``preflight``: a GPU backend without a GPU), before any file is touched.
     stickslip.output_safety.errors.OutputError
         If ``output`` cannot be written, or holds another run and ``overwrite`` is false.
     """
     plugin = registry.get("solver", solver)
     params = parse_params(plugin.params, values, owner=f"solver '{plugin.name}'")
+    if plugin.preflight is not None:
+        plugin.preflight(params)
     used = set_num_threads(threads)
     check_output(output)
     with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint):

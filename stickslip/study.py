@@ -35,6 +35,7 @@ import re
 from pathlib import Path
 
 from . import registry
+from .hashing import short_hash
 from .lineage import Artifact
 from .params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
@@ -117,6 +118,47 @@ class SimulationJob:
     def artifact(self):
         """The output as an :class:`~stickslip.lineage.Artifact`."""
         return Artifact(self.path, self.run_id, self.solver, self.format)
+
+
+@dataclasses.dataclass(frozen=True)
+class SimulationBatch:
+    """Runs of one solver made by one job on a GPU (:data:`BATCHED_PARAMS` equal): their minimisations share launches.
+
+    Attributes
+    ----------
+    solver : str
+    batch_id : str
+        A hash of its runs' ids (a rule name: letters, digits, ``_``).
+    runs : tuple[SimulationJob, ...]
+    """
+
+    solver: str
+    batch_id: str
+    runs: tuple
+
+
+#: What runs of one GPU batch share (the device mesh, its operators, the law, the time step, the drive); they may
+#: differ in every other parameter (seed, drive stiffness, protocol, temperature, ...).
+BATCHED_PARAMS = ("N", "plates", "K", "G", "rho", "dt_scale", "drive", "lever_height", "interface_law", "law_params")
+
+
+def gpu_batches(simulations, size):
+    """The GPU batches of a study's runs (:class:`SimulationBatch`): ``fem`` runs with ``backend = cuda`` sharing
+    :data:`BATCHED_PARAMS`, in run-id order, at most ``size`` each; none if ``size`` < 2."""
+    if size < 2:
+        return []
+    groups = {}
+    for sim in simulations:
+        if sim.solver == "fem" and sim.params.get("backend") == "cuda":
+            key = json.dumps([sim.params.get(name) for name in BATCHED_PARAMS], sort_keys=True)
+            groups.setdefault(key, []).append(sim)
+    batches = []
+    for key in sorted(groups):
+        runs = groups[key]
+        for first in range(0, len(runs), size):
+            members = tuple(runs[first:first + size])
+            batches.append(SimulationBatch("fem", "b" + short_hash([sim.run_id for sim in members]), members))
+    return batches
 
 
 @dataclasses.dataclass(frozen=True)
@@ -307,6 +349,8 @@ class Study:
     threads : int
     simulations : list[SimulationJob]
         Sorted by solver, then run id; no duplicates.
+    batches : list[SimulationBatch]
+        The GPU batches (config ``gpu_batch``): each made by one job; the other runs one job each.
     meshes : dict[str, dict]
         Mesh id -> mesh parameters.
     analyses : dict[str, dict]
@@ -322,6 +366,7 @@ class Study:
         self.threads = int(config.get("threads", 1))
         self.meshes = {}
         self.simulations = self._simulations(config.get("solvers") or {})
+        self.batches = gpu_batches(self.simulations, int(config.get("gpu_batch", 0)))
         self.analyses, self.analysis_jobs = self._analyses(config.get("analyses") or {})
         self.figures = self._figures(config.get("figures") or {})
 
@@ -428,6 +473,11 @@ class Study:
     def log(self, name):
         """Return the log file ``results/{study}/logs/{name}.log`` (``name`` may hold wildcards)."""
         return f"{self.root}/{PATHS['logs']}/{name}.log"
+
+    def unbatched(self, solver):
+        """A regular expression of the run ids of ``solver`` made one job each (not in a GPU batch)."""
+        batched = sorted(sim.run_id for batch in self.batches if batch.solver == solver for sim in batch.runs)
+        return f"(?!({'|'.join(batched)})$)[^/]+" if batched else "[^/]+"
 
     def simulation(self, solver, run_id):
         """Return the :class:`SimulationJob` with this solver and run id (KeyError if none)."""

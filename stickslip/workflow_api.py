@@ -33,6 +33,7 @@ import sys
 import tempfile
 import traceback
 from pathlib import Path
+from types import SimpleNamespace
 
 from . import registry
 from .h5io import FileFormatError, open_file
@@ -209,29 +210,81 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
     with _logged(log):
         from .numba_options import set_num_threads
 
-        plugin, params = _load("solver", solver, params_json, module)
-        run_id, code = registry.run_id(plugin, params), code_hash(plugin.module)
-        output, partial = Path(output), partial_path(output)
-        _refuse_other_outputs([output], record, run_id)
-        if _completed_before(partial, run_id, code):
-            _publish(partial, output)
-            _publish(kept_record(partial), Path(record))
-            print(f"{plugin.name} run {run_id}: completed by an earlier job ({partial}), not recomputed")
-            return
-        inputs = _artifacts(inputs)
-        for role, path in inputs.items():
-            _check_hdf5(role, path)
+        job = _solver_job(solver, params_json, output, record, inputs, module)
+        if job is not None:
+            _run_solver_job(job, set_num_threads(threads))
+
+
+def run_simulation_batch(solver, params_jsons, outputs, records, log, *, inputs, threads, numba_cache="shared",
+                         module=None):
+    """Run several runs of one solver as one batch on a GPU (``backend = cuda``): one job, one file per run.
+
+    Every run is as :func:`run_simulation` makes it (its file, its provenance record, resumed or left
+    alone as there); the runs not completed before advance together, one thread each, their
+    minimisations sharing the device's launches (:func:`stickslip.fem.backends.cuda.run_ensemble`).
+
+    Parameters
+    ----------
+    solver : str
+    params_jsons, outputs, records : Sequence
+        Per run, as :func:`run_simulation`'s ``params_json``, ``output``, ``record``.
+    log : str or pathlib.Path
+        The batch's log (every run's lines).
+    inputs : Sequence[str or Mapping]
+        Per run, as :func:`run_simulation`'s ``inputs``.
+    threads, numba_cache, module
+        As :func:`run_simulation`.
+    """
+    prepare_environment(threads, numba_cache)
+    with _logged(log):
+        from .fem.backends.cuda import run_ensemble
+        from .numba_options import set_num_threads
+
+        jobs = [_solver_job(solver, *job, module) for job in zip(params_jsons, outputs, records, inputs)]
+        pending = [job for job in jobs if job is not None]
         used = set_num_threads(threads)
-        with _plugin_recording(record, [("output", output, plugin.produces)], plugin, params, run_id, code=code,
-                               threads=used, inputs=sorted(inputs.items())) as job:
-            print(f"solver {plugin.name} {plugin.version}, {used} thread(s), {json.dumps(job['params'])}")
-            partial.parent.mkdir(parents=True, exist_ok=True)
-            if partial.exists():
-                print(f"resuming from {partial}")
-            plugin.run(params, partial, threads=used, inputs={k: v.path for k, v in inputs.items()})
-            kept = _publish(partial, output)
-        if kept:
-            _publish(Path(record), kept_record(partial))
+        print(f"batch of {len(jobs)} runs, {len(jobs) - len(pending)} completed before")
+        run_ensemble([lambda backend, job=job: _run_solver_job(job, used, backend) for job in pending])
+
+
+def _solver_job(solver, params_json, output, record, inputs, module):
+    """One solver run checked and ready to run, or None if an earlier job completed it (its files put in place).
+
+    Raises what :func:`run_simulation` says of its inputs (the solver's preflight included) before any file is
+    touched.
+    """
+    plugin, params = _load("solver", solver, params_json, module)
+    if plugin.preflight is not None:  # e.g. a GPU backend without a GPU: said before any file is touched
+        plugin.preflight(params)
+    run_id, code = registry.run_id(plugin, params), code_hash(plugin.module)
+    output, partial = Path(output), partial_path(output)
+    _refuse_other_outputs([output], record, run_id)
+    if _completed_before(partial, run_id, code):
+        _publish(partial, output)
+        _publish(kept_record(partial), Path(record))
+        print(f"{plugin.name} run {run_id}: completed by an earlier job ({partial}), not recomputed")
+        return None
+    inputs = _artifacts(inputs)
+    for role, path in inputs.items():
+        _check_hdf5(role, path)
+    return SimpleNamespace(plugin=plugin, params=params, run_id=run_id, code=code, output=output, partial=partial,
+                           record=Path(record), inputs=inputs)
+
+
+def _run_solver_job(job, threads, backend=None):
+    """Run a :func:`_solver_job` into its second name, record it, and put it in place (``backend``: a batch's)."""
+    plugin, inputs = job.plugin, job.inputs
+    with _plugin_recording(job.record, [("output", job.output, plugin.produces)], plugin, job.params, job.run_id,
+                           code=job.code, threads=threads, inputs=sorted(inputs.items())) as record:
+        print(f"solver {plugin.name} {plugin.version}, {threads} thread(s), {json.dumps(record['params'])}")
+        job.partial.parent.mkdir(parents=True, exist_ok=True)
+        if job.partial.exists():
+            print(f"resuming from {job.partial}")
+        extra = {} if backend is None else {"backend": backend}
+        plugin.run(job.params, job.partial, threads=threads, inputs={k: v.path for k, v in inputs.items()}, **extra)
+        kept = _publish(job.partial, job.output)
+    if kept:
+        _publish(job.record, kept_record(job.partial))
 
 
 def kept_record(partial):

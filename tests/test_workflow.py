@@ -144,8 +144,8 @@ def test_bad_config_value_stops_before_any_job(tmp_path, toy_distribution):
     (tmp_path / "bad.yaml").write_text(TOY_YAML + "thread: 2\n")
     result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
     assert result.returncode != 0
-    assert ("config key thread: not a key of the config (did you mean 'threads'?); allowed: study, threads, solvers, "
-            "analyses, figures") in result.stdout + result.stderr
+    assert ("config key thread: not a key of the config (did you mean 'threads'?); allowed: study, threads, "
+            "gpu_batch, solvers, analyses, figures") in result.stdout + result.stderr
     (tmp_path / "bad.yaml").write_text(TOY_YAML.replace("params: {slips: 4}", "params: {slips: 4, seed: 2}"))
     result = snakemake(tmp_path, "-n", "--configfile", "bad.yaml", distribution=toy_distribution, check=False)
     assert result.returncode != 0

@@ -55,7 +55,7 @@ def _yields(epsy, dofs, dNdx, u, du, idx, s, yield_element):
 
 
 @njit
-def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_element):
+def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_element, bisect=True):
     """Step along the linear response to the brink of yielding (load) or just past it (kick).
 
     Parameters
@@ -80,6 +80,9 @@ def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_el
         Kick (True) or elastic load step (False).
     yield_element : bool
         Kick: require all 4 Gauss points of one element to change well.
+    bisect : bool, optional
+        False (kicks only): the first candidate step that yields, unrefined, which carries its Gauss point
+        ``deps_kick / 2`` past its yield strain rather than just past it.
 
     Returns
     -------
@@ -110,6 +113,8 @@ def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_el
     if i == candidates.size:
         return -1.0
     right = candidates[i]
+    if kick and not bisect:
+        return right
     left = candidates[i - 1] if i > 0 else 0.0
     for _ in range(MAX_BISECTIONS):
         mid = 0.5 * (right + left)

@@ -32,7 +32,7 @@ class Loading:
         self.deps = deps
         stack.backend.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
 
-    def step_size(self, kick, yield_element=False):
+    def step_size(self, kick, yield_element=False, bisect=True):
         """The step along the linear response that :meth:`step` makes (nothing is changed).
 
         Parameters
@@ -41,6 +41,9 @@ class Loading:
             Kick (smallest step that changes a well index) or elastic load step (largest step that changes none).
         yield_element : bool
             Kick until all Gauss points of one element change well.
+        bisect : bool, optional
+            False: a kick to ``deps / 2`` past the nearest yield strain, not refined to just past it
+            (:func:`.event_driven.step_size`).
 
         Returns
         -------
@@ -56,7 +59,7 @@ class Loading:
         u, eps, idx = self.stack.backend.read("u", "eps", "idx")
         r = self.response
         step = step_size(m.epsy, m.iface_dofs, m.iface_dNdx, u, r.delta_u, eps, r.delta_eps, idx, self.deps, kick,
-                         yield_element and kick)
+                         yield_element and kick, bisect)
         if step < 0.0:
             raise SolverError("no step along the linear response makes a block yield")
         return step
@@ -89,6 +92,15 @@ class Loading:
         step = self.step_size(kick, yield_element)
         self.load(step)
         changed = np.any(self.stack.backend.read("idx")[0] != idx)
+        if kick and not changed:
+            # the step is found with the CPU's arithmetic, to just past a yield strain; a backend of other round-off
+            # (a GPU's fused multiply-adds) can leave the point a rounding error short of it: kick again from where
+            # it is, to deps / 2 past it. Never on the CPU backends, which evaluate the trial displacement bit for
+            # bit as the step was found.
+            extra = self.step_size(kick, yield_element, bisect=False)
+            self.load(extra)
+            step += extra
+            changed = np.any(self.stack.backend.read("idx")[0] != idx)
         if kick != changed:
             raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
                               f"{'did not change' if kick else 'changed'}")

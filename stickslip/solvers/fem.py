@@ -16,7 +16,7 @@ from ..fem.run import run_simulation
 from ..h5io import FileFormatError
 from ..mesh import MeshParams, build_stack_mesh, read_mesh
 
-__all__ = ["FemParams", "run", "stack_mesh", "VERSION"]
+__all__ = ["FemParams", "run", "stack_mesh", "can_run", "VERSION"]
 
 #: Algorithm version (part of every run id); bump when results change.
 VERSION = "4"  # 4: exact relaxation by QDLDL and fixed-order loops (host-independent bits); 3: stencil passes three entries at a time (round-off); 2: structured plate kernel, relaxation, dt_scale
@@ -50,8 +50,18 @@ def stack_mesh(params, inputs):
     return mesh
 
 
-@registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
-def run(params, output, *, threads=1, inputs=None):
-    """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics."""
-    run_simulation(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
+def can_run(params):
+    """Raise :class:`stickslip.params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
+    make_backend(params.backend)
+
+
+@registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay,
+                   preflight=can_run)
+def run(params, output, *, threads=1, inputs=None, backend=None):
+    """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics.
+
+    ``backend``: a backend object of ``params.backend`` to run on (a GPU batch's,
+    :func:`stickslip.workflow_api.run_simulation_batch`); default: a new one.
+    """
+    run_simulation(params, output, stack_mesh(params, inputs), backend or make_backend(params.backend, threads),
                    producer=("fem", VERSION))

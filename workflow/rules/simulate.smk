@@ -1,5 +1,6 @@
 # One rule for every solver: the solver is a wildcard (a path component), chosen in the config. The job
-# receives its upstream files (the mesh) with their lineage (params.inputs).
+# receives its upstream files (the mesh) with their lineage (params.inputs). Runs of a GPU batch (config
+# gpu_batch, stickslip.study.gpu_batches) are made by one job of their batch's rule, each to its usual file.
 
 
 rule simulate:
@@ -13,6 +14,8 @@ rule simulate:
     benchmark:
         STUDY.path("benchmark")
     threads: STUDY.threads
+    wildcard_constraints:
+        run_id=STUDY.unbatched("fem"),
     params:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
         inputs=lambda wildcards: Study.dumps(STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
@@ -22,3 +25,30 @@ rule simulate:
         CONDA_ENV
     script:
         "../scripts/simulate.py"
+
+
+for BATCH in STUDY.batches:
+
+    rule:
+        name:
+            f"simulate_batch_{BATCH.batch_id}"
+        input:
+            sorted({str(path) for sim in BATCH.runs for path in STUDY.solver_inputs(sim.solver, sim.run_id).values()}),
+        output:
+            h5=[sim.path for sim in BATCH.runs],
+            record=[record_of(sim.path) for sim in BATCH.runs],
+        log:
+            STUDY.log(f"sim/{BATCH.solver}/batch-{BATCH.batch_id}"),
+        threads: STUDY.threads
+        resources:
+            gpu=1,
+        params:
+            solver=BATCH.solver,
+            params=[Study.dumps(sim.params) for sim in BATCH.runs],
+            inputs=[Study.dumps(STUDY.solver_inputs(sim.solver, sim.run_id)) for sim in BATCH.runs],
+            code=Study.code("solver", BATCH.solver),
+            module=Study.module("solver", BATCH.solver),
+        conda:
+            CONDA_ENV
+        script:
+            "../scripts/simulate_batch.py"

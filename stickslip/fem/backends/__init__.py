@@ -2,15 +2,18 @@
 
 A backend is chosen once per run (:func:`make_backend`) and prepared for its model (it then owns
 the state; :mod:`.base` is the seam every backend implements). Built in: ``structured`` (default)
-and ``assembled`` (the reference), numba CPU backends (:mod:`.cpu`). A backend whose results are
+and ``assembled`` (the reference), numba CPU backends (:mod:`.cpu`), and ``cuda`` (an NVIDIA GPU,
+:mod:`.cuda`; optional dependency numba-cuda). A backend whose results are
 bit-identical to the default's would be an execution option like ``threads``; both alternatives
 here change the round-off, so the choice is the ``backend`` parameter of ``fem`` (recorded in the
 run file and its id). A new backend: one module and :func:`register_backend` (docs/developing.md,
 "A new backend").
 """
 
+from ...params import ParameterError
 from .base import CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend
 from .cpu import AssembledBackend, StructuredBackend
+from .cuda import CudaBackend
 
 __all__ = ["BACKENDS", "DEFAULT_BACKEND", "Backend", "make_backend", "register_backend", "FIELDS", "CONVERGED",
            "MARGIN", "QUIET", "MAX_ITER_REACHED"]
@@ -32,6 +35,7 @@ def register_backend(cls):
 
 register_backend(StructuredBackend)
 register_backend(AssembledBackend)
+register_backend(CudaBackend)
 
 
 def make_backend(name=DEFAULT_BACKEND, threads=1):
@@ -39,12 +43,13 @@ def make_backend(name=DEFAULT_BACKEND, threads=1):
 
     Raises
     ------
-    ValueError
-        If no backend of that name is registered, or it cannot run on this machine (the reason).
+    stickslip.params.ParameterError
+        If no backend of that name is registered, or it cannot run on this machine (the message says why).
     """
     if name not in BACKENDS:
-        raise ValueError(f"backend {name!r}: expected one of {', '.join(sorted(BACKENDS))}")
+        raise ParameterError(f"parameter 'backend': {name!r} is not a backend; expected one of "
+                             f"{', '.join(sorted(BACKENDS))}")
     reason = BACKENDS[name].unavailable()
     if reason:
-        raise ValueError(f"backend {name!r} cannot run here: {reason}")
+        raise ParameterError(f"parameter 'backend': {name!r} cannot run on this machine: {reason}")
     return BACKENDS[name](threads=threads)

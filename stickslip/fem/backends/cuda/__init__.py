@@ -1,0 +1,202 @@
+"""Backend ``cuda``: the fem model on an NVIDIA GPU, whole minimisations on the device, batches of realisations.
+
+A run's state lives in one slot of a :class:`.batch.DeviceBatch` on the device; the backend of the
+run (:class:`CudaBackend`) implements the seam of :mod:`..base` on that slot. A minimisation is one
+or more launches of the minimisation kernel (:mod:`.kernels`), each advancing up to
+:data:`.batch.STEPS_PER_LAUNCH` time steps before the host reads a status word: velocity Verlet, the
+interface law (the law's own Python functions compiled for the device), the drive, the residual
+criterion, the quiet window and the margin all run there. Runs of one mesh started together
+(:func:`run_ensemble`) share their launches: one launch advances every realisation of the batch,
+each computed exactly as alone.
+
+What is kept: the same run gives the same bytes run after run on one GPU, whatever the batch and
+the number of blocks a realisation is spread over (no floating-point atomics; every sum in a fixed
+order, :mod:`.layout`). Against the CPU the round-off differs (other summation orders, and the
+device compiler fuses multiplies and adds): the same events from the same state within the
+reference tolerance, not the same bytes, so ``cuda`` is a value of the ``backend`` parameter with
+its own run ids. The exact relaxation solves on the host (:meth:`CudaBackend.correct`: the force
+out, the correction in, once per Newton iteration). Needs ``numba-cuda`` (``pip install
+stickslip[gpu]``) and a GPU with its driver; ``NUMBA_ENABLE_CUDASIM=1`` runs it on numba's CUDA
+simulator (tests, tiny meshes).
+"""
+
+import importlib.util
+import threading
+
+import numpy as np
+
+from ..base import Backend
+
+__all__ = ["CudaBackend", "run_ensemble"]
+
+
+def _why_not():
+    """Why the device cannot be used ("" if it can)."""
+    if importlib.util.find_spec("numba_cuda") is None:
+        return "numba-cuda is not installed; install the GPU extra: pip install stickslip[gpu]"
+    from numba import cuda  # numba-cuda's target (numba's own is deprecated)
+    from numba import config
+
+    if config.ENABLE_CUDASIM:
+        return ""
+    try:
+        if cuda.is_available():
+            return ""
+        reason = "numba-cuda found no CUDA driver or GPU"
+    except Exception as error:  # numba-cuda raises its own errors for a missing or broken driver
+        reason = f"numba-cuda cannot use the GPU: {error}"
+    return f"{reason}; run on a machine with an NVIDIA GPU or choose a CPU backend (structured, assembled)"
+
+
+class CudaBackend(Backend):
+    """The fem model on an NVIDIA GPU (module docstring).
+
+    Parameters
+    ----------
+    threads : int, optional
+        Ignored (the device's threads are the kernels' business); kept for the common signature.
+    ensemble : .batch.Ensemble, optional
+        The batch the run belongs to (:func:`run_ensemble`); None: the run has the device to itself.
+    groups : int, optional
+        Blocks a realisation is spread over in a minimisation (default: as many as the device's
+        multiprocessors allow); the results do not depend on it.
+    """
+
+    name = "cuda"
+    summary = "NVIDIA GPU (numba-cuda): whole minimisations on the device, batches of runs in one launch"
+
+    def __init__(self, threads=1, ensemble=None, groups=None):
+        self.threads = int(threads)
+        self.ensemble = ensemble
+        self.groups = groups
+        self.model = self.batch = self.slot = None
+        self.device_mesh = None
+
+    @classmethod
+    def unavailable(cls):
+        return _why_not()
+
+    def prepare(self, model, mesh):
+        from .batch import DeviceBatch, DeviceMesh  # numba-cuda is optional: imported when a run asks for it
+
+        if self.ensemble is not None:
+            batch = self.ensemble.batch_for(model)
+        else:
+            batch = DeviceBatch(self.device_mesh or DeviceMesh(model), model.law, 1, self.groups)
+        return self.bound(model, batch)
+
+    def for_model(self, model):
+        from .batch import DeviceBatch
+
+        return self.bound(model, DeviceBatch(self.batch.mesh, model.law, 1, self.groups))
+
+    def bound(self, model, batch):
+        """A backend for ``model`` in a free slot of ``batch``, at rest at the origin."""
+        bound = CudaBackend(self.threads, self.ensemble, self.groups)
+        bound.model, bound.batch, bound.device_mesh = model, batch, batch.mesh
+        bound.slot = batch.attach(model, bound)
+        bound.set_state(np.zeros(model.ndof), np.zeros(model.layer_volume.size), 0.0, 0.0)
+        return bound
+
+    def read(self, *fields):
+        return self.batch.read(self.slot, fields)
+
+    def set_state(self, u, target, lever_target, t):
+        zeros = np.zeros(self.model.ndof)
+        self.batch.upload(self.slot, u=u, v=zeros, a=zeros, target=target, lever0=lever_target, clock=t)
+        self.batch.evaluate(self.slot, True)
+
+    def set_time(self, t):
+        self.batch.upload(self.slot, clock=t)
+
+    def set_load_direction(self, delta_u, delta_target, delta_lever):
+        self.batch.upload(self.slot, delta_u=delta_u, delta_target=delta_target, delta_lever=np.array(delta_lever))
+
+    def load(self, step):
+        self.batch.load(self.slot, step)
+        self.batch.evaluate(self.slot, True)
+
+    def add_u(self, dofs, delta):
+        self.batch.add_u(self.slot, dofs, delta)
+        self.batch.evaluate(self.slot, True)
+
+    def correct(self, dofs, solve):
+        f = self.batch.read(self.slot, ("f",))[0]
+        self.batch.add_u(self.slot, dofs, -solve(f[dofs]))
+        return self.batch.evaluate(self.slot, False)
+
+    def rest_in_wells(self):
+        self.batch.stop(self.slot)
+        self.batch.evaluate(self.slot, False)
+
+    def set_yield_strains(self, epsy, shift=None):
+        self.model = self.model._replace(epsy=epsy)
+        self.batch.set_yield_strains(self.slot, epsy, shift)
+        self.batch.evaluate(self.slot, True)
+
+    def checkpoint(self):
+        return self.batch.checkpoint(self.slot)
+
+    def rollback(self, token):
+        self.batch.rollback(self.slot, token)
+
+    def minimise(self, tol, niter_tol, max_iter, margin, record, quiet=0):
+        return self.batch.minimise(self.slot, tol, niter_tol, max_iter, margin, record, quiet)
+
+    def advance(self, nsteps):
+        # no stopping criterion: a tolerance no residual is below, no margin, no quiet window
+        self.batch.minimise(self.slot, 0.0, 1, nsteps, 0, False, 0)
+
+    def residual(self):
+        return self.batch.residual(self.slot)
+
+    def wells_hold(self):
+        return self.batch.wells_hold(self.slot)
+
+
+def run_ensemble(runs, groups=None):
+    """Run several simulations of one mesh on the GPU as one batch: one thread per run, shared launches.
+
+    Parameters
+    ----------
+    runs : Sequence[callable]
+        ``run(backend)`` makes one run with the backend it is given (e.g. a closure over
+        :func:`stickslip.fem.run.run_simulation` with its parameters and output file).
+    groups : int, optional
+        Blocks per realisation (default: spread over the device).
+
+    Returns
+    -------
+    list
+        What each run returned, in order.
+
+    Raises
+    ------
+    BaseException
+        The first error of a run, after every run ended (the others are not interrupted).
+    """
+    from .batch import Ensemble
+
+    ensemble = Ensemble(len(runs), groups)
+    results, errors = [None] * len(runs), [None] * len(runs)
+    joined = threading.Barrier(len(runs)) if runs else None
+
+    def one(i):
+        ensemble.join()
+        joined.wait()  # every run is a participant before any minimisation is launched
+        try:
+            results[i] = runs[i](CudaBackend(ensemble=ensemble))
+        except BaseException as error:  # reported after the others ended
+            errors[i] = error
+        finally:
+            ensemble.leave()
+
+    threads = [threading.Thread(target=one, args=(i,), name=f"cuda-run-{i}") for i in range(len(runs))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for error in errors:
+        if error is not None:
+            raise error
+    return results
