@@ -14,6 +14,7 @@ for both laws, and the hop's kick carries every Gauss point of the block over th
 
 import math
 import os
+import signal
 import subprocess
 import sys
 
