@@ -61,9 +61,10 @@ from stickslip.numba_options import njit, set_num_threads
 SMALL = 10
 
 
-def _affine_response(params, mesh):
-    """An affine simple shear (gamma = eps0) as the loading direction, scaled like the true response."""
-    stack = build_stack(params, mesh, make_backend(params.backend), derived_constants(params, mesh))
+def affine_response(params, mesh):
+    """An affine simple shear (gamma = eps0) as the loading direction, scaled like the true response (timing only:
+    no solve; computed on the host's ``structured`` backend, whatever ``params.backend``)."""
+    stack = build_stack(params, mesh, make_backend(), derived_constants(params, mesh))
     u = np.zeros(stack.model.ndof)
     u[mesh.dofs[:, 0]] = 2.0 * params.eps0 * mesh.coor[:, 1]
     target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height)
@@ -77,7 +78,7 @@ def _affine_response(params, mesh):
 def _loaded_simulation(args, mesh, threads, backend):
     """A simulation right after a kick (blocks yielding), loaded along an affine shear, and its wells before the kick."""
     params = FemParams(N=args.N, plates=args.plates, nchunk=200, backend=backend)
-    sim = Simulation(params, mesh, make_backend(backend, threads), response=_affine_response(params, mesh))
+    sim = Simulation(params, mesh, make_backend(backend, threads), response=affine_response(params, mesh))
     sim.loading.step(kick=False)
     index = sim.stack.backend.read("idx")[0].copy()
     sim.loading.step(kick=True)

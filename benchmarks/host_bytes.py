@@ -38,8 +38,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-import h5py
 import numpy as np
+
+from stickslip.h5io import read_datasets
 
 #: One short run of each solver and relaxation: (solver, KEY=VALUE parameters).
 CASES = {
@@ -97,22 +98,9 @@ def settings(flags):
     return out
 
 
-def _datasets(path):
-    """Every dataset of an HDF5 file by name."""
-    found = {}
-
-    def keep(name, item):  # returns None: visititems stops at the first other value
-        if isinstance(item, h5py.Dataset):
-            found[name] = item[()]
-
-    with h5py.File(path, "r") as file:
-        file.visititems(keep)
-    return found
-
-
 def first_difference(path, reference):
     """The first dataset (by name) whose values differ, with the largest absolute difference; None if none."""
-    a, b = _datasets(path), _datasets(reference)
+    a, b = read_datasets(path), read_datasets(reference)
     for name in sorted(set(a) | set(b)):
         if name not in a or name not in b or np.shape(a[name]) != np.shape(b[name]):
             return f"{name} (missing or other shape)"

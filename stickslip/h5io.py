@@ -32,7 +32,7 @@ import pandas as pd
 from .output_safety.errors import OutputError
 from .output_safety.write_guard import WriteGuard
 
-__all__ = ["open_file", "write_dataset", "read_array", "write_table", "read_table", "write_attrs", "copy_file",
+__all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs", "copy_file",
            "FileFormatError", "UnreadableFileError", "CorruptFileError"]
 
 LIBVER = ("v110", "v110")
@@ -208,6 +208,29 @@ def read_array(dataset, selection=()):
                 dataset.refresh()
     raise CorruptFileError(f"{dataset.file.filename}: dataset {dataset.name} is damaged and cannot be read "
                            f"({failure}); remake the file (rerun the job that wrote it)") from None
+
+
+def read_datasets(path):
+    """Every dataset of an HDF5 file, read whole (a comparison of two files' numbers, not a reader of a format).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    dict[str, numpy.ndarray or scalar]
+        Each dataset's data by its path in the file (e.g. ``"state/u"``).
+    """
+    found = {}
+
+    def keep(name, item):  # returns None: visititems stops at the first other value
+        if isinstance(item, h5py.Dataset):
+            found[name] = item[()]
+
+    with h5py.File(path, "r") as file:
+        file.visititems(keep)
+    return found
 
 
 def write_attrs(obj, attrs):

@@ -19,6 +19,7 @@ from stickslip.fem.backends import make_backend
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.run import run_simulation
 from stickslip.formats.fem_run import read_increments, read_run_attrs
+from stickslip.h5io import read_datasets
 from stickslip.mesh import MeshParams, build_stack_mesh
 
 CASE = ["N=9", "plates=2", "relaxation=exact", "max_increments=6", "nchunk=100"]
@@ -33,16 +34,9 @@ def _simulate(output, *extra):
 
 def _content(path):
     """Every dataset and attribute of a file (an in-place edit of attributes changes the bytes, not these)."""
-    found = {}
-
-    def keep(name, item):  # returns None: visititems stops at the first other value
-        if isinstance(item, h5py.Dataset):
-            found[name] = item[()]
-
     with h5py.File(path, "r") as file:
-        file.visititems(keep)
         attrs = {key: (value.tolist() if isinstance(value, np.ndarray) else value) for key, value in file.attrs.items()}
-    return found, attrs
+    return read_datasets(path), attrs
 
 
 def _same_content(a, b):

@@ -47,16 +47,14 @@ from stickslip.fem.backends import make_backend
 from stickslip.fem.backends.cuda import CudaBackend, run_ensemble
 from stickslip.fem.backends.cuda import batch as batch_module
 from stickslip.fem.backends.cuda.batch import STEPS_PER_LAUNCH, DeviceBatch
-from stickslip.fem.constants import derived_constants
-from stickslip.fem.event_driven import autoscale
-from stickslip.fem.linear_response import LinearResponse
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.run import run_simulation
 from stickslip.fem.simulation import Simulation
-from stickslip.fem.stack import build_stack
 from stickslip.fem.stiffness import PAPER_PHI, stiffness_ratio
-from stickslip.fem.yield_strains import interface_initstate, narrowest_well
 from stickslip.mesh import MeshParams, build_stack_mesh
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from bench_fem import affine_response  # noqa: E402  (the load direction of the CPU benchmark: the same steps)
 
 ROOT = Path(__file__).resolve().parents[2]
 REFERENCE = ROOT / ".device" / "reference" / "FixedLever_historic.h5"
@@ -87,19 +85,6 @@ def emit(out, **record):
 def k_drive(phi, N):
     """The drive stiffness of rigidity ratio ``phi`` at ``N`` blocks (``stiffness_ratio`` is linear in it)."""
     return phi / stiffness_ratio(1.0, N)
-
-
-def affine_response(params, mesh):
-    """A simple shear (gamma = eps0) as the load direction, scaled like the linear response (timing only)."""
-    stack = build_stack(params, mesh, make_backend(), derived_constants(params, mesh))
-    u = np.zeros(stack.model.ndof)
-    u[mesh.dofs[:, 0]] = 2.0 * params.eps0 * mesh.coor[:, 1]
-    target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height)
-    stack.backend.set_state(u, target, 0.0, 0.0)
-    eps = stack.backend.read("eps")[0].copy()
-    scale = autoscale(narrowest_well(interface_initstate(params.seed, mesh.N, mesh.n_interfaces), params.nchunk,
-                                     params.eps0, params.eps_offset, params.weibull_k), eps)
-    return LinearResponse(scale * u, scale * eps, scale * target, 0.0)
 
 
 # --- parts --------------------------------------------------------------------------------------------
