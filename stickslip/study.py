@@ -142,14 +142,18 @@ class SimulationBatch:
 BATCHED_PARAMS = ("N", "plates", "K", "G", "rho", "dt_scale", "drive", "lever_height", "interface_law", "law_params")
 
 
+def runs_on_gpu(sim):
+    """Whether a :class:`SimulationJob` runs on a GPU (``fem`` with ``backend = cuda``)."""
+    return sim.solver == "fem" and sim.params.get("backend") == "cuda"
+
+
 def gpu_batches(simulations, size):
     """The GPU batches of a study's runs (:class:`SimulationBatch`): ``fem`` runs with ``backend = cuda`` sharing
     :data:`BATCHED_PARAMS`, in run-id order, at most ``size`` each; none if ``size`` < 2."""
     if size < 2:
         return []
     groups = {}
-    for sim in simulations:
-        if sim.solver == "fem" and sim.params.get("backend") == "cuda":
+    for sim in filter(runs_on_gpu, simulations):
             key = json.dumps([sim.params.get(name) for name in BATCHED_PARAMS], sort_keys=True)
             groups.setdefault(key, []).append(sim)
     batches = []
@@ -474,10 +478,14 @@ class Study:
         """Return the log file ``results/{study}/logs/{name}.log`` (``name`` may hold wildcards)."""
         return f"{self.root}/{PATHS['logs']}/{name}.log"
 
-    def unbatched(self, solver):
-        """A regular expression of the run ids of ``solver`` made one job each (not in a GPU batch)."""
-        batched = sorted(sim.run_id for batch in self.batches if batch.solver == solver for sim in batch.runs)
-        return f"(?!({'|'.join(batched)})$)[^/]+" if batched else "[^/]+"
+    def single_runs(self, on_gpu):
+        """A regular expression of the run ids made one job each by rule ``simulate`` (``on_gpu`` False: every
+        run not on a GPU) or ``simulate_gpu`` (True: the runs on a GPU that are in no GPU batch)."""
+        gpu = {sim.run_id for sim in self.simulations if runs_on_gpu(sim)}
+        if not on_gpu:  # a run id is 16 characters: the lookahead sees all of it (a `$` in it would see the path's end)
+            return f"(?!({'|'.join(sorted(gpu))}))[0-9a-f]{{16}}" if gpu else "[0-9a-f]{16}"
+        alone = sorted(gpu - {sim.run_id for batch in self.batches for sim in batch.runs})
+        return f"({'|'.join(alone)})" if alone else "(?!)"
 
     def simulation(self, solver, run_id):
         """Return the :class:`SimulationJob` with this solver and run id (KeyError if none)."""

@@ -2,15 +2,18 @@
 
 The ci study runs through the SLURM profile (every job through sbatch) on a cluster without an
 accounting database, and gives the same HDF5 files and database as a local run. With the wrong status
-command, or more CPUs or memory per job than the node has, the workflow stops at start with a message
-instead of hanging. Ctrl-C or SIGTERM cancels the jobs a run has submitted. Every snakemake run is under a
-timeout: a hang fails the test.
+command, or more CPUs, memory or GPUs per job than the node has, the workflow stops at start with a message
+instead of hanging. Ctrl-C or SIGTERM cancels the jobs a run has submitted. The jobs on a GPU go to the GPU
+partition asking for one GPU of the type named (the node's GPU is a generic resource without a device:
+the jobs themselves stop with the cuda backend's one line where the machine has no GPU). Every snakemake
+run is under a timeout: a hang fails the test.
 
 Needs root and Debian's SLURM packages (tests/slurm/packages.txt; `bash .ci/run` installs them); skipped
 with the reason otherwise (failed instead where STICKSLIP_REQUIRE_SLURM is set, as .ci/run does).
 """
 
 import os
+import re
 import signal
 import sqlite3
 import subprocess
@@ -20,6 +23,7 @@ import pytest
 import yaml
 
 from conftest import REPO, copy_workflow, python_path
+from stickslip.fem.backends.cuda import CudaBackend
 from stickslip.study import Study
 
 CLUSTER = REPO / "tests" / "slurm" / "cluster.sh"
@@ -27,6 +31,21 @@ CI = ["--configfile", "workflow/config/ci.yaml"]
 #: The profile, the accounting-less cluster's status command, status checks every few seconds.
 SLURM = ["--workflow-profile", "profiles/slurm", "--slurm-status-command", "squeue",
          "--slurm-init-seconds-before-status-checks", "5"]
+
+#: fem runs on a GPU, one load increment each, in batches of at most 2 (config gpu_batch): two batch jobs.
+GPU_STUDY = """
+gpu_batch: 2
+solvers:
+  fem:
+    - params: {N: 9, plates: 2, max_increments: 1, backend: cuda, relaxation: exact}
+      grid: {seed: [1, 2, 3]}
+analyses: {}
+figures: {}
+"""
+#: The same beside a run on the CPU.
+MIXED_STUDY = GPU_STUDY.replace("analyses:", "    - params: {N: 9, plates: 2, max_increments: 1}\nanalyses:")
+#: Where the profile sends the jobs on a GPU, and the GPU type they ask for (tests/slurm/cluster.sh: its node's GPU).
+GPU_ENV = {"STICKSLIP_SLURM_GPU_PARTITION": "gpu", "STICKSLIP_SLURM_GPU_MODEL": "testgpu"}
 
 pytestmark = pytest.mark.slow
 
@@ -94,6 +113,27 @@ def slurm_jobs(env):
 def new_jobs(env, before):
     """Jobs of :func:`slurm_jobs` not in ``before``."""
     return {job: state for job, state in slurm_jobs(env).items() if job not in before}
+
+
+def submitted_requests(env, jobs):
+    """What each of ``jobs`` (SLURM job ids) asked for, from ``scontrol show job``: job id -> its fields."""
+    out = subprocess.run(["scontrol", "show", "job", "--oneliner"], env=env, capture_output=True, text=True,
+                         timeout=60, check=True).stdout
+    fields = [dict(re.findall(r"(\S+?)=(\S*)", line)) for line in out.splitlines()]
+    return {job["JobId"]: job for job in fields if job.get("JobId") in jobs}
+
+
+def planned_resources(output):
+    """The resources of every job of a dry run's plan: list of (rule, {resource: value as printed})."""
+    jobs = re.findall(r"^rule (\S+):\n(?:    .*\n)*?    resources: (.*)$", output, re.M)
+    return [(rule, dict(item.split("=", 1) for item in resources.split(", "))) for rule, resources in jobs]
+
+
+def gpu_study(directory, text):
+    """The workflow in ``directory`` with the study ``text`` as gpu.yaml; returns the snakemake arguments to run it."""
+    copy_workflow(directory)
+    (directory / "gpu.yaml").write_text(text)
+    return ["--configfile", "gpu.yaml"]
 
 
 def table(database, query):
@@ -175,3 +215,69 @@ def test_an_interrupted_run_cancels_its_submitted_jobs(cluster, partition_down, 
     status, output = finish(process, directory, timeout=120)
     assert status != 0
     assert set(new_jobs(cluster, before).values()) == {("stickslip", "CANCELLED")}, output[-4000:]
+
+
+@pytest.mark.parametrize("gpu_batch, gpu_rule, gpu_jobs", [(2, "simulate_batch_", 2), (0, "simulate_gpu", 3)])
+def test_the_jobs_on_a_gpu_plan_with_the_gpu_partition_and_type(tmp_path, gpu_batch, gpu_rule, gpu_jobs):
+    # a dry run (no cluster needed): every job on a GPU, a run alone (simulate_gpu) or a batch (a rule of its own,
+    # named after its runs), has the profile's GPU resources; the other jobs the CPU partition and no GPU
+    args = gpu_study(tmp_path, MIXED_STUDY)
+    env = dict(os.environ, PYTHONPATH=python_path(), STICKSLIP_SLURM_PARTITION="stickslip", **GPU_ENV)
+    status, output = run_snakemake(tmp_path, env, "-n", "--workflow-profile", "profiles/slurm", *args,
+                                   "--config", f"gpu_batch={gpu_batch}", timeout=300)
+    assert status == 0, output[-4000:]
+    planned = planned_resources(output)
+    on_gpu = [resources for rule, resources in planned if rule.startswith(gpu_rule)]
+    assert len(on_gpu) == gpu_jobs
+    for resources in on_gpu:
+        assert (resources["slurm_partition"], resources["gpu"], resources["gpu_model"]) == ("gpu", "1", "testgpu")
+        assert (resources["runtime"], resources["mem_mb"]) == ("1440", "16000")
+    others = {rule: resources for rule, resources in planned if not rule.startswith(gpu_rule)}
+    assert set(others) == {"mesh", "simulate", "database", "all"}
+    assert all(resources["slurm_partition"] == "stickslip" and "gpu" not in resources for resources in others.values())
+
+
+def test_the_jobs_on_a_gpu_are_submitted_to_the_gpu_partition_asking_for_the_gpu(cluster, tmp_path):
+    args = gpu_study(tmp_path, GPU_STUDY)
+    env = dict(cluster, STICKSLIP_SLURM_NUMBA_CACHE="shared", **GPU_ENV)
+    before = slurm_jobs(cluster)
+    # --retries 0: a failed job is not submitted again (the profile retries once)
+    status, output = run_snakemake(tmp_path, env, *SLURM, *args, "--retries", "0", timeout=600)
+    requests = submitted_requests(cluster, new_jobs(cluster, before))
+    rules = {job["Comment"].removeprefix("rule_").split("_wildcards_")[0]: job for job in requests.values()}
+    batches = [job for rule, job in rules.items() if rule.startswith("simulate_batch_")]
+    assert len(requests) == 3 and "mesh" in rules and len(batches) == 2, output[-4000:]
+    assert (rules["mesh"]["Partition"], rules["mesh"]["JobState"]) == ("stickslip", "COMPLETED")
+    assert "TresPerJob" not in rules["mesh"]
+    for job in batches:
+        assert (job["Partition"], job["TresPerJob"]) == ("gpu", "gres:gpu:testgpu:1")
+        assert (job["TimeLimit"], job["MinMemoryNode"]) == ("1-00:00:00", "16000M")
+    logs = sorted((tmp_path / "results" / "gpu" / "logs" / "sim" / "fem").glob("batch-*.log"))
+    assert len(logs) == 2
+    if CudaBackend.unavailable():  # the node's GPU is a name only: each job stops with the backend's one line
+        assert status != 0 and {job["JobState"] for job in batches} == {"FAILED"}
+        for log in logs:
+            assert "parameter 'backend': 'cuda' cannot run on this machine: " in log.read_text()
+        assert not list((tmp_path / "results" / "gpu" / "sim" / "fem").glob("*.h5"))
+    else:
+        assert status == 0 and {job["JobState"] for job in batches} == {"COMPLETED"}, output[-4000:]
+
+
+@pytest.mark.parametrize("env, args, message", [
+    # --set-resources replaces the profile's set-resources: the partition of every job, any GPU type
+    ({}, ["--set-resources", "simulate_gpu:gpu=2"],
+     "asks for 2 GPUs per job, but the nodes of partition 'stickslip' have at most 1 (sinfo: gpu:testgpu:1): "
+     "sbatch would refuse the job; set STICKSLIP_SLURM_GPU_PARTITION to a partition with GPUs"),
+    ({"STICKSLIP_SLURM_GPU_MODEL": "h100"}, [],
+     "asks for 1 GPU of type h100 per job, but the nodes of partition 'gpu' have none (sinfo: gpu:testgpu:1): "
+     "sbatch would refuse the job; set STICKSLIP_SLURM_GPU_MODEL to a type they have (testgpu) or set "
+     "STICKSLIP_SLURM_GPU_PARTITION to a partition with GPUs"),
+], ids=["more-gpus-than-a-node-has", "a-gpu-type-the-partition-lacks"])
+def test_a_gpu_job_that_no_node_can_run_stops_at_start(cluster, tmp_path, env, args, message):
+    # the settings of every job on a GPU apply to the batches' rules as well (set-resources of simulate_gpu)
+    study = gpu_study(tmp_path, GPU_STUDY)
+    before = slurm_jobs(cluster)
+    status, output = run_snakemake(tmp_path, {**cluster, **GPU_ENV, **env}, *SLURM, *study, *args, timeout=300)
+    assert status != 0
+    assert re.search(r"SLURM: rule simulate_batch_\w+ " + re.escape(message), " ".join(output.split())), output[-4000:]
+    assert slurm_jobs(cluster) == before  # nothing was submitted

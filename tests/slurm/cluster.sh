@@ -10,6 +10,10 @@
 # (the test skips with that reason); any other failure is an error. Everything lives in DIR: munge key and
 # socket, state, spool, logs, ports chosen free at start. No accounting database (accounting_storage/none,
 # as on clusters without slurmdbd): `sacct` answers from slurmctld for finished jobs within MinJobAge only.
+# The node has one GPU of type `testgpu`, a generic resource without a device file (gres.conf with `Count=`
+# and no `File=`): a job that asks for it (`--gpus=1`, `--gpus=testgpu:1`) is scheduled and its request
+# recorded (`scontrol show job`: TresPerJob), though no process can use it. Partitions `test` (the default),
+# `stickslip` and `gpu`, each of the one node.
 #
 # The one thing outside DIR is the link /run/slurm/conf -> DIR, removed at stop. Inside each job the jobstep
 # executor plugin (snakemake-executor-plugin-slurm-jobstep 0.6.1) runs `srun` with every SLURM_* variable
@@ -120,9 +124,16 @@ MinJobAge=600
 SlurmctldTimeout=30
 SlurmdTimeout=30
 MpiDefault=none
-NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$memory State=UNKNOWN
+GresTypes=gpu
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$memory Gres=gpu:testgpu:1 State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
 PartitionName=stickslip Nodes=$host Default=NO MaxTime=INFINITE State=UP
+PartitionName=gpu Nodes=$host Default=NO MaxTime=INFINITE State=UP
+EOF
+# slurmd reads gres.conf beside slurm.conf; AutoDetect off: nothing probes for real devices
+cat > "$dir/gres.conf" <<EOF
+AutoDetect=off
+NodeName=$host Name=gpu Type=testgpu File=/dev/null
 EOF
 
 mkdir -p "$(dirname "$node_conf")"

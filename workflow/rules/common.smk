@@ -74,14 +74,28 @@ def record_of(pattern):
     return record_path(pattern).as_posix()
 
 
+#: The rule whose resources set in a profile (`set-resources`) or with --set-resources every job on a GPU gets:
+#: a single run on a GPU is made by this rule, a GPU batch by a rule of its own (simulate_batch_<id>, named after
+#: its runs, so a profile cannot name it).
+GPU_RULE = "simulate_gpu"
+
+
+def with_gpu_rule_resources(name):
+    """Give rule ``name`` the resources set for :data:`GPU_RULE`; what is set for ``name`` itself still wins."""
+    overwrite = workflow.resource_settings.overwrite_resources
+    for source in (GPU_RULE, name):
+        workflow.get_rule(name).resources.update(overwrite.get(source, {}))
+
+
 onstart:
     # A SLURM run checks, before submitting anything, that it would not hang (stickslip.cluster).
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
+        from snakemake_executor_plugin_slurm.partitions import parse_gpu_requirements
         from stickslip.cluster import JobRequest, SlurmSetupError, check_slurm
         from stickslip.termination import raise_interrupt_on_sigterm
 
         requests = [JobRequest(job.rule.name, job.threads, job.resources.get("mem_mb"),
-                               job.resources.get("slurm_partition") or None)
+                               job.resources.get("slurm_partition") or None, *parse_gpu_requirements(job))
                     for job in workflow.dag.needrun_jobs() if not job.is_local]
         try:
             settings = workflow.executor_settings

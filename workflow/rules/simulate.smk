@@ -1,6 +1,8 @@
 # One rule for every solver: the solver is a wildcard (a path component), chosen in the config. The job
-# receives its upstream files (the mesh) with their lineage (params.inputs). Runs of a GPU batch (config
-# gpu_batch, stickslip.study.gpu_batches) are made by one job of their batch's rule, each to its usual file.
+# receives its upstream files (the mesh) with their lineage (params.inputs). A run on a GPU (fem, backend cuda)
+# is made by rule simulate_gpu, the same rule asking for a GPU; runs of a GPU batch (config gpu_batch,
+# stickslip.study.gpu_batches) by one job of their batch's rule, each to its usual file. Every job on a GPU
+# has the resources that a profile sets for simulate_gpu (GPU_RULE, common.smk: a GPU partition, profiles/slurm).
 
 
 rule simulate:
@@ -15,7 +17,7 @@ rule simulate:
         STUDY.path("benchmark")
     threads: STUDY.threads
     wildcard_constraints:
-        run_id=STUDY.unbatched("fem"),
+        run_id=STUDY.single_runs(on_gpu=False),
     params:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
         inputs=lambda wildcards: Study.dumps(STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
@@ -25,6 +27,13 @@ rule simulate:
         CONDA_ENV
     script:
         "../scripts/simulate.py"
+
+
+use rule simulate as simulate_gpu with:
+    wildcard_constraints:
+        run_id=STUDY.single_runs(on_gpu=True),
+    resources:
+        gpu=1,
 
 
 for BATCH in STUDY.batches:
@@ -52,3 +61,5 @@ for BATCH in STUDY.batches:
             CONDA_ENV
         script:
             "../scripts/simulate_batch.py"
+
+    with_gpu_rule_resources(f"simulate_batch_{BATCH.batch_id}")
