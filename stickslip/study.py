@@ -154,8 +154,8 @@ def gpu_batches(simulations, size):
         return []
     groups = {}
     for sim in filter(runs_on_gpu, simulations):
-            key = json.dumps([sim.params.get(name) for name in BATCHED_PARAMS], sort_keys=True)
-            groups.setdefault(key, []).append(sim)
+        key = json.dumps([sim.params.get(name) for name in BATCHED_PARAMS], sort_keys=True)
+        groups.setdefault(key, []).append(sim)
     batches = []
     for key in sorted(groups):
         runs = groups[key]
