@@ -18,7 +18,7 @@ from collections import namedtuple
 
 import numpy as np
 
-__all__ = ["LEAVES", "ITEMS_PER_CHUNK", "DeviceLayout", "device_layout", "fixed_sum_plan", "fixed_sum"]
+__all__ = ["LEAVES", "ITEMS_PER_CHUNK", "DeviceLayout", "device_layout", "fixed_sum_plan"]
 
 #: Leaves of the fixed-order sums' tree (a power of 2).
 LEAVES = 256
@@ -46,36 +46,6 @@ DeviceLayout = namedtuple("DeviceLayout", [
 def fixed_sum_plan(n):
     """``R`` of the fixed-order sum of ``n`` items: ``LEAVES * R`` chunks of about :data:`ITEMS_PER_CHUNK` items."""
     return max(1, -(-int(n) // (LEAVES * ITEMS_PER_CHUNK)))
-
-
-def fixed_sum(values, chunks_per_leaf=None):
-    """The fixed-order sum of the device kernels, on the host (float64 [n] -> float; the same order and bits).
-
-    The reference of the device sums (tests): chunk sums, the leaves' sums of chunks, then the tree.
-    ``chunks_per_leaf``: ``R`` (default :func:`fixed_sum_plan` of ``n``; the layers' sums share the ``R``
-    of the largest layer).
-    """
-    values = np.asarray(values, dtype=np.float64)
-    n = values.size
-    chunks = LEAVES * (chunks_per_leaf or fixed_sum_plan(n))
-    partial = np.zeros(chunks)
-    for c in range(chunks):
-        s = 0.0
-        for i in range(c, n, chunks):
-            s += values[i]
-        partial[c] = s
-    leaves = np.zeros(LEAVES)
-    for leaf in range(LEAVES):
-        s = 0.0
-        for c in range(leaf, chunks, LEAVES):
-            s += partial[c]
-        leaves[leaf] = s
-    stride = LEAVES // 2
-    while stride:
-        for t in range(stride):
-            leaves[t] = leaves[t] + leaves[t + stride]
-        stride //= 2
-    return float(leaves[0])
 
 
 def _gathers(iface_dofs, ndof):
