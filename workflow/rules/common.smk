@@ -74,14 +74,15 @@ def record_of(pattern):
     return record_path(pattern).as_posix()
 
 
-#: The rule whose resources set in a profile (`set-resources`) or with --set-resources every job on a GPU gets:
-#: a single run on a GPU is made by this rule, a GPU batch by a rule of its own (simulate_batch_<id>, named after
-#: its runs, so a profile cannot name it).
+#: Every job on a GPU gets the resources that a profile (`set-resources`) or --set-resources sets for this one
+#: (a single run on a GPU is made by it; a GPU batch by simulate_batch_<id>, named after its runs, which a profile
+#: cannot name). No comment here may hold the word 'rule' and a colon on one line: snakemake --lint reads it as a
+#: rule beside the functions.
 GPU_RULE = "simulate_gpu"
 
 
 def with_gpu_rule_resources(name):
-    """Give rule ``name`` the resources set for :data:`GPU_RULE`; what is set for ``name`` itself still wins."""
+    """Give the resources set for GPU_RULE to the rule ``name`` (a GPU batch); what is set for ``name`` itself wins."""
     overwrite = workflow.resource_settings.overwrite_resources
     for source in (GPU_RULE, name):
         workflow.get_rule(name).resources.update(overwrite.get(source, {}))
