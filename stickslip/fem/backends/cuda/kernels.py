@@ -71,6 +71,18 @@ def kernels_for(law_name):
     equivalent, well = items.equivalent, items.well
 
     @_device
+    def placement(members, G):
+        """Where the calling thread works in a launch of ``G`` blocks per listed realisation.
+
+        Returns ``(m, part, t, bd, gt, nt)``: the realisation ``m``, the block's ``part`` of its ``G`` blocks, the
+        thread ``t`` of ``bd`` in the block, and its rank ``gt`` of the ``nt`` threads over the realisation's blocks.
+        """
+        block = cuda.blockIdx.x
+        part = block % G
+        t, bd = cuda.threadIdx.x, cuda.blockDim.x
+        return members[block // G], part, t, bd, part * bd + t, G * bd
+
+    @_device
     def member_barrier(counter, m, G, passed):
         """All threads of realisation ``m``'s ``G`` blocks meet; ``passed``: barriers this block passed before."""
         cuda.syncthreads()
@@ -212,11 +224,7 @@ def kernels_for(law_name):
                  dof_chunks, u, v, a, f, idx, eps, sig, fe, target, ubar, lever, epsy, ny, k_drive, ubar_part,
                  res_part, residual, counter):
         """Evaluate everything that follows from ``u`` (and the drive) for the listed realisations; their residual."""
-        block = cuda.blockIdx.x
-        m = members[block // G]
-        part = block % G
-        t, bd = cuda.threadIdx.x, cuda.blockDim.x
-        gt, nt = part * bd + t, G * bd
+        m, part, t, bd, gt, nt = placement(members, G)
         leaves = cuda.shared.array((_ROWS, _L), float64)
         scale = cuda.shared.array(MAX_LAYERS, float64)
         ue = cuda.local.array(8, float64)
@@ -241,11 +249,7 @@ def kernels_for(law_name):
                  tol, niter_tol, max_iter, margin, quiet, record, steps, unchanged_steps, history, moved_at, near_at,
                  status, previous, events, nevent, counter):
         """Up to ``nsteps`` time steps of the minimisation of every listed realisation (module docstring)."""
-        block = cuda.blockIdx.x
-        m = members[block // G]
-        part = block % G
-        t, bd = cuda.threadIdx.x, cuda.blockDim.x
-        gt, nt = part * bd + t, G * bd
+        m, part, t, bd, gt, nt = placement(members, G)
         leaves = cuda.shared.array((_ROWS, _L), float64)
         scale = cuda.shared.array(MAX_LAYERS, float64)
         decision = cuda.shared.array(1, int64)
@@ -337,12 +341,9 @@ def kernels_for(law_name):
 
     def residual(members, G, dof_chunks, free, multiplicity, damping, f, v, res_part, out, counter):
         """The relative residual of every listed realisation's state as it is."""
-        block = cuda.blockIdx.x
-        m = members[block // G]
-        part = block % G
-        t, bd = cuda.threadIdx.x, cuda.blockDim.x
+        m, part, t, bd, gt, nt = placement(members, G)
         leaves = cuda.shared.array((_ROWS, _L), float64)
-        residual_chunks(m, part * bd + t, G * bd, dof_chunks, free, multiplicity, damping, f, v, res_part)
+        residual_chunks(m, gt, nt, dof_chunks, free, multiplicity, damping, f, v, res_part)
         member_barrier(counter, m, G, 0)
         value = residual_of(m, t, bd, dof_chunks, res_part, leaves)
         if part == 0 and t == 0:
