@@ -111,9 +111,26 @@ def host():
             "numpy_simd": [name for name in __cpu_dispatch__ if __cpu_features__.get(name)]}
 
 
-def segments(text):
-    """The arithmetic segments stored in a run file's ``arithmetic`` attribute (JSON list; [] if absent)."""
-    return json.loads(text) if text else []
+def segments(text, path="the run file"):
+    """The arithmetic segments stored in a run file's ``arithmetic`` attribute (JSON list; [] if absent).
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the attribute is not a JSON list of objects (the message names ``path``).
+    """
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", "replace")
+    if not isinstance(text, str):
+        raise FileFormatError(f"{path}: attribute 'arithmetic' is a {type(text).__name__}, expected JSON text")
+    try:
+        found = json.loads(text) if text else []
+    except ValueError as error:
+        raise FileFormatError(f"{path}: attribute 'arithmetic' is not JSON ({error})") from None
+    if not isinstance(found, list) or not all(isinstance(item, dict) for item in found):
+        raise FileFormatError(f"{path}: attribute 'arithmetic' is {text[:80]!r}, expected a JSON list of objects "
+                              "(one per segment of arithmetic)")
+    return found
 
 
 def differences(stored, current):
@@ -150,7 +167,7 @@ def check_resume(path, stored_text, nstored, allow=None):
         and how to continue anyway.
     """
     allow = os.environ.get(CONTINUE_VARIABLE) == "1" if allow is None else allow
-    stored = segments(stored_text)
+    stored = segments(stored_text, path)
     current = decisive()
     changed = differences(stored[-1] if stored else {}, current)
     if not changed:
