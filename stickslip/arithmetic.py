@@ -140,7 +140,7 @@ def differences(stored, current):
             and stored.get(name) != current.get(name)]
 
 
-def check_resume(path, stored_text, nstored, allow=None):
+def check_resume(path, stored_text, nstored, allow=None, extra=None):
     """Check that a run can resume under this process's arithmetic; return the attribute to store.
 
     Parameters
@@ -154,6 +154,9 @@ def check_resume(path, stored_text, nstored, allow=None):
         Increments stored: a new segment would hold from this one.
     allow : bool, optional
         Continue under another arithmetic (default: :data:`CONTINUE_VARIABLE` is ``1``).
+    extra : Mapping[str, object], optional
+        What else decides the run's bits beside :func:`decisive` (a backend's device:
+        :func:`stickslip.fem.backends.backend_arithmetic`), compared as well.
 
     Returns
     -------
@@ -168,7 +171,7 @@ def check_resume(path, stored_text, nstored, allow=None):
     """
     allow = os.environ.get(CONTINUE_VARIABLE) == "1" if allow is None else allow
     stored = segments(stored_text, path)
-    current = decisive()
+    current = {**decisive(), **(extra or {})}
     changed = differences(stored[-1] if stored else {}, current)
     if not changed:
         return None

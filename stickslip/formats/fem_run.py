@@ -18,7 +18,9 @@ equal runs give equal bytes):
     ``protocol`` = "thermal", ``temperature``, ``attempt_rate``, ``drive_rate``, ``hold_times``,
     ``hold_delay``, ``energy_unit``: docs/fem.md, "Finite temperature"); then ``version``
     (package), ``arithmetic`` (what decides the bits of the numbers: a JSON list of segments, each
-    :func:`stickslip.arithmetic.decisive` with the ``from_increment`` it holds from; one segment unless
+    :func:`stickslip.arithmetic.decisive`, for a ``cuda`` run with its GPU, driver, numba-cuda and
+    whether numba's CUDA simulator ran it (:func:`stickslip.fem.backends.gpu_arithmetic`), and the
+    ``from_increment`` it holds from; one segment unless
     a resume was told to continue under another, :func:`check_arithmetic`), ``nstored`` (complete
     increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or "max_increments").
     Format version 2 added ``arithmetic``.
@@ -106,7 +108,7 @@ def _check_header(header):
         raise ValueError(f"fem-run header: regime must be one of {', '.join(REGIMES)}, got {header['regime']!r}")
 
 
-def create_file(file, header, mesh, linear_response, columns, dtypes=None, state_fields=None):
+def create_file(file, header, mesh, linear_response, columns, dtypes=None, state_fields=None, arithmetic=None):
     """Write the header of a new ``fem-run`` file (no increment yet).
 
     Parameters
@@ -126,6 +128,9 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
     state_fields : Mapping[str, tuple], optional
         Further state stored per increment: name -> ``(shape, dtype)`` of one increment's value
         (datasets ``/state/<name>``; :func:`append_increment` takes their values as a fifth item).
+    arithmetic : Mapping[str, object], optional
+        What decides the bits beside :func:`stickslip.arithmetic.decisive` (a device backend's GPU,
+        :func:`stickslip.fem.backends.backend_arithmetic`), recorded with it in ``arithmetic``.
 
     Raises
     ------
@@ -134,7 +139,7 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
     """
     _check_header(header)
     formats.stamp(file, FORMAT)
-    arithmetic = json.dumps([{"from_increment": 0, **decisive()}], sort_keys=True)
+    arithmetic = json.dumps([{"from_increment": 0, **decisive(), **(arithmetic or {})}], sort_keys=True)
     write_attrs(file, {**header, "version": __version__, "arithmetic": arithmetic, "nstored": 0, "completed": False,
                        "stop_reason": ""})
     save_mesh(mesh, file.create_group("mesh"))
@@ -219,13 +224,15 @@ def rewrite(path, **attrs):
             write_attrs(target, attrs)
 
 
-def check_arithmetic(path):
+def check_arithmetic(path, arithmetic=None):
     """Before a resume: the attributes that record this process's arithmetic, if it is not the stored one.
 
     Parameters
     ----------
     path : str or pathlib.Path
         An incomplete simulation file.
+    arithmetic : Mapping[str, object], optional
+        As :func:`create_file`'s: compared too.
 
     Returns
     -------
@@ -241,7 +248,7 @@ def check_arithmetic(path):
     with open_file(path) as file:
         _check(file)
         stored, nstored = file.attrs.get("arithmetic", ""), stored_increments(file)
-    text = check_resume(path, stored, nstored)
+    text = check_resume(path, stored, nstored, extra=arithmetic)
     return {} if text is None else {"arithmetic": text}
 
 
