@@ -131,9 +131,9 @@ class FemRun(_Run):
         self.params = self.header["params"]
         self.solver = str(self.header["solver"])
 
-    def __repr__(self):
+    def __repr__(self):  # the file's name, as h5py's File shows it (the whole path: .path)
         h = self.header
-        return (f"<FemRun {self.path}: {self.solver} blocks={h['N']} plates={h['plates']} phi={h['phi']:.3g} "
+        return (f"<FemRun {self.path.name}: {self.solver} blocks={h['N']} plates={h['plates']} phi={h['phi']:.3g} "
                 f"({h['regime']}), {h['nstored']} increments{', completed' if h['completed'] else ''}>")
 
     def _stored(self, increment):
@@ -297,7 +297,7 @@ class TimeseriesRun(_Run):
 
     def __repr__(self):
         r = self.record
-        return (f"<TimeseriesRun {self.path}: {self.solver or 'lab recording'} {r.protocol} n={r.n} "
+        return (f"<TimeseriesRun {self.path.name}: {self.solver or 'lab recording'} {r.protocol} n={r.n} "
                 f"{r.t_x[-1] - r.t_x[0]:.0f} s>")
 
     def events(self, **analysis_params):
