@@ -242,7 +242,7 @@ class FemRun(_Run):
         -------
         pandas.DataFrame
             ``interface`` (a, 1 = lowest), ``block`` (0 ... N-1), ``t`` (time since the kick [FE time]),
-            ``direction`` (+1 / -1): one row per well hop; ``attrs["units"]``.
+            ``hop_direction`` (+1 / -1): one row per well hop; ``attrs["units"]``.
 
         Raises
         ------
@@ -252,7 +252,7 @@ class FemRun(_Run):
             If the increment is not a kick, or the solver cannot replay events.
         """
         failures = self._replay.failures(self._stored(increment))
-        return with_units(failures.rename(columns={"a": "interface"}))
+        return with_units(failures.rename(columns={"a": "interface", "direction": "hop_direction"}))
 
 
 class TimeseriesRun(_Run):

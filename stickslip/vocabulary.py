@@ -169,7 +169,7 @@ QUANTITIES = {
     "lever_target": _q("float64", "length", "drive target at the lever's drive height (free lever)"),
     "lever_position": _q("float64", "length", "the lever's position at its drive height (free lever)"),
     "hop_block": _q("int64", _ID, "the block that hopped (thermal run; -1 for none)"),
-    "hop_direction": _q("int64", _ID, "direction of the hop, +1 / -1 (thermal run)"),
+    "hop_direction": _q("int64", _ID, "direction of a well hop, +1 / -1 (a thermal run's increments; failures)"),
     "failed_hops": _q("int64", "1", "hops over a barrier that failed (thermal run)"),
     "held": _q("float64", "time", "time of the increment during which the drive was held (thermal run)"),
     "s": _q("int64", "1", "number of interfaces that slipped in the event"),
@@ -182,7 +182,6 @@ QUANTITIES = {
     "last_increment": _q("int64", _ID, "last increment of that run"),
     "length": _q("int64", "1", "number of slip events in the run of slips"),
     "block": _q("int64", _ID, "block of the interface, 0 ... N - 1 from the left"),
-    "direction": _q("int64", _ID, "direction of a well hop, +1 / -1"),
     # --- experiment-events: slips and interfaces of a recording
     "driven": _q("bool", _LABEL, "the interface can slip (stack: a <= n; individual: the driven slab)"),
     "R_tot": _q("float64", "mm", "total sliding of the interface over the analysed record"),
@@ -257,7 +256,7 @@ RENAMED = {
     "slip_interfaces": {"a": "interface", "dmu": "dmu_sig0", "single": "multi (negated)"},
     "slips (experiment-events)": {"a": "interface", "t": "time", "dR": "slip", "dR_from_dF": "slip_from_dF"},
     "interfaces": {"a": "interface"},
-    "failures": {"a": "interface"},
+    "failures": {"a": "interface", "direction": "hop_direction"},
     "truth": {"a": "interface", "dR": "slip"},
 }
 

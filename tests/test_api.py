@@ -120,10 +120,10 @@ def test_a_fem_state_is_the_stored_state_with_the_fields_the_run_observed(fem_ru
 def test_a_replayed_event_is_the_stored_event(fem_runs):
     _, run = fem_runs
     failures = run.failures(44)
-    assert list(failures.columns) == ["interface", "block", "t", "direction"]
-    assert failures.attrs["units"] == {"interface": "", "block": "", "t": "time", "direction": ""}
+    assert list(failures.columns) == ["interface", "block", "t", "hop_direction"]
+    assert failures.attrs["units"] == {"interface": "", "block": "", "t": "time", "hop_direction": ""}
     assert (np.diff(failures["t"]) >= 0).all() and set(failures["block"]) == set(range(FEM["N"]))
-    net = failures.groupby("block")["direction"].sum()
+    net = failures.groupby("block")["hop_direction"].sum()
     assert int(net.sum()) == run.increments.loc[44, "S_a1"]
     with pytest.raises(FileFormatError, match="increment 43 is not a stored kick increment"):
         run.failures(43)  # a load step
@@ -138,7 +138,7 @@ def test_a_virtual_experiment_reads_as_analyze_experiment_writes_it(lever_runs, 
     status, text = _cli("analyze-experiment", cli, "-o", tmp_path / "slips.csv", "--aging")
     assert status == 0
     slips = run.events()["slips"]
-    written = pd.read_csv(tmp_path / "slips.csv").drop(columns="run")
+    written = pd.read_csv(tmp_path / "slips.csv").drop(columns="path")
     pd.testing.assert_frame_equal(slips, written, check_dtype=False, rtol=1e-15)
     fit = run.aging()
     assert text.splitlines()[-1] == f"B={fit.B:.4g} +- {fit.B_error:.2g}"
