@@ -169,7 +169,7 @@ def _write(frame, args, columns):
     if args.format == "csv":
         frame.to_csv(sys.stdout, index=False)
     elif args.format == "json":
-        sys.stdout.write(frame.to_json(orient="records", indent=1) + "\n")
+        sys.stdout.write(frame.to_json(orient="records", indent=1, date_format="iso") + "\n")
     elif frame.empty:
         print("(no rows)")
     else:
