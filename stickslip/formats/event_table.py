@@ -10,6 +10,10 @@ add tables of its own beside it. Numerical (``numerical-events``) and experiment
 An optional one-row table ``periodicity`` (:data:`PERIODICITY_COLUMNS`) holds the periodicity
 and synchronisation measures of the run's slip events (:mod:`stickslip.events.periodicity`);
 the database keeps it in its table ``run_periodicity``.
+
+Version 2: the package's vocabulary (:mod:`stickslip.vocabulary`): a numerical analysis writes its drops in
+``dmu_sig0`` [sig0] and its clock in ``t`` [time], leaving ``dmu`` [1] and ``time`` [s] to the lab's; the
+periodicity counts are ``n_slips``, ``n_multi``, ``n_spanning``.
 """
 
 import numpy as np
