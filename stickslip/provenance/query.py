@@ -197,8 +197,8 @@ def _parameters(names):
                 if field.name in names:
                     default = list(field.default) if isinstance(field.default, tuple) else field.default
                     found.setdefault(field.name, []).append(
-                        (plugin.name, lambda value, cls=plugin.params, name=field.name, owner=plugin.name:
-                         parse_value(cls, name, value, owner=f"{kind} '{owner}'"), default))
+                        (plugin.name, lambda value, cls=plugin.params, name=field.name, owner=f"{kind} '{plugin.name}'":
+                         parse_value(cls, name, value, owner=owner), default))
     return found
 
 
