@@ -342,7 +342,7 @@ def part_compare(out):
                 table = read_increments(path)
                 kicks = table[table["kick"]].iloc[1:]
                 sizes += list(kicks[[c for c in table.columns if c.startswith("S_a")]].sum(axis=1))
-                drops += list(slip_interfaces(classify_increments(table, SIZES["mid"]), SIZES["mid"])["dmu"])
+                drops += list(slip_interfaces(classify_increments(table, SIZES["mid"]), SIZES["mid"])["dmu_sig0"])
             samples[side] = (np.asarray(sizes, float), np.asarray(drops, float))
         if any(samples[side][0].size == 0 for side in samples):
             emit(out, part="compare", regime=regime, error="an ensemble is missing")

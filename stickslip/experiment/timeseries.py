@@ -350,11 +350,11 @@ def describe(path):
     Returns
     -------
     dict[str, object]
-        ``protocol``, ``n`` (driven slabs), ``a`` (slab driven alone, 0 for the stack) and
-        ``seed`` (None for lab data, which has no seed attribute).
+        ``protocol``, ``n`` (driven slabs), ``driven_slab`` (the attribute ``a``: the slab driven alone, 0 for
+        the stack) and ``seed`` (None for lab data, which has no seed attribute).
     """
     with h5io.open_file(path) as f:
         formats.check(f, FORMAT)
         return {"protocol": h5io.attribute(f, "protocol", "str"), "n": h5io.attribute(f, "n", "int"),
-                "a": h5io.attribute(f, "a", "int", 0, required=False),
+                "driven_slab": h5io.attribute(f, "a", "int", 0, required=False),
                 "seed": h5io.attribute(f, "seed", "int", required=False)}
