@@ -16,6 +16,7 @@ import warnings
 
 import numpy as np
 import pytest
+from conftest import time_to_stop
 
 from stickslip.fem.errors import SolverError
 from stickslip.fem.laws import Cusp
@@ -201,15 +202,7 @@ def _terminate_inside(process, path, stored, settle):
         time.sleep(0.2)
     time.sleep(settle)
     assert process.poll() is None, "the run ended before the signal"
-    process.send_signal(signal.SIGTERM)
-    start = time.monotonic()
-    try:
-        process.wait(timeout=30)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.wait()
-        pytest.fail("the run went on for 30 s after SIGTERM (inside a kernel call that does not return)")
-    return time.monotonic() - start
+    return time_to_stop(process, signal.SIGTERM, 30, "the run (inside a kernel call that does not return)")
 
 
 @pytest.mark.slow
