@@ -33,12 +33,12 @@ def test_both_backends_run_the_same_events(relaxation):
         for sim in (reference, other):
             sim.loading.step(False)
             assert sim.protocol.kick(params.margin)[0]
-        wells, u = reference.stack.well_index(), reference.stack.backend.read("u")[0]
+        wells, u = reference.stack.well_index(), reference.backend.read("u")[0]
         np.testing.assert_array_equal(other.stack.well_index(), wells, err_msg=f"event {event}")
         slips += int(np.count_nonzero(wells != before))
         scale = np.abs(u).max()
         tolerance = 1e-10 if relaxation == "exact" else 1e-6  # exact: solved equilibria; dynamic: tol 1e-5
-        other_u = other.stack.backend.read("u")[0]
+        other_u = other.backend.read("u")[0]
         assert np.abs(other_u - u).max() < tolerance * scale, f"event {event}"
         assert other_u.tobytes() != u.tobytes() or event == 0  # other round-off, indeed
     assert slips > 12  # the events moved wells

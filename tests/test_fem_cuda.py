@@ -64,9 +64,9 @@ PRELUDE = """
         return cpu, gpu
 
     def compare(cpu, gpu):
-        out = {"idx": bool(np.array_equal(cpu.stack.backend.read("idx")[0], gpu.stack.backend.read("idx")[0]))}
+        out = {"idx": bool(np.array_equal(cpu.backend.read("idx")[0], gpu.backend.read("idx")[0]))}
         for name in FIELDS:
-            a, b = cpu.stack.backend.read(name)[0], gpu.stack.backend.read(name)[0]
+            a, b = cpu.backend.read(name)[0], gpu.backend.read(name)[0]
             scale = float(np.abs(a).max())
             out[name] = float(np.abs(a - b).max()) / scale if scale else float(np.abs(b).max())
         return out
@@ -123,9 +123,9 @@ def simulated(numba_cuda):
             sim.loading.step(True)
         out[f"{drive}:kick"] = compare(cpu, gpu)
         for sim in (cpu, gpu):
-            sim.stack.backend.advance(3)
+            sim.backend.advance(3)
         out[f"{drive}:steps"] = compare(cpu, gpu)
-        out[f"{drive}:residual"] = abs(cpu.stack.backend.residual() / gpu.stack.backend.residual() - 1)
+        out[f"{drive}:residual"] = abs(cpu.backend.residual() / gpu.backend.residual() - 1)
     # the step limit, with the well changes of Gauss point 0 recorded: block 4 sheared ~10 wells ahead (it and
     # its neighbours change wells in the first steps)
     cpu, gpu = pair()
@@ -133,28 +133,28 @@ def simulated(numba_cuda):
     for sim in (cpu, gpu):
         sim.loading.step(False)
         sim.loading.step(True)
-        sim.stack.backend.add_u(sim.stack.model.iface_dofs[4], 6e-3 * mode)
-    runs = [sim.stack.backend.minimise(1e-5, 20, 6, 0, True, 0) for sim in (cpu, gpu)]
+        sim.backend.add_u(sim.model.iface_dofs[4], 6e-3 * mode)
+    runs = [sim.backend.minimise(1e-5, 20, 6, 0, True, 0) for sim in (cpu, gpu)]
     out["limit"] = [runs[0][:2], runs[1][:2], bool(np.array_equal(runs[0][2], runs[1][2])), len(runs[0][2]),
                     compare(cpu, gpu)]
     # the quiet window: from a state at rest after a load step no well changes
     cpu, gpu = pair()
     for sim in (cpu, gpu):
         sim.loading.step(False)
-    runs = [sim.stack.backend.minimise(1e-5, 50, 100, 0, False, 3)[:2] for sim in (cpu, gpu)]
+    runs = [sim.backend.minimise(1e-5, 50, 100, 0, False, 3)[:2] for sim in (cpu, gpu)]
     out["quiet"] = [runs[0], runs[1], compare(cpu, gpu)]
     # the residual criterion, after the exact relaxation's direct solve (its Newton iterations on the device)
     cpu, gpu = pair(relaxation="exact")
-    solved = [sim.relaxation.solve_in_wells(sim.stack.backend) for sim in (cpu, gpu)]
-    runs = [sim.stack.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2] for sim in (cpu, gpu)]
-    out["converged"] = [solved, runs[0], runs[1], compare(cpu, gpu), float(np.abs(gpu.stack.backend.read("v")[0]).max())]
+    solved = [sim.relaxation.solve_in_wells(sim.backend) for sim in (cpu, gpu)]
+    runs = [sim.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2] for sim in (cpu, gpu)]
+    out["converged"] = [solved, runs[0], runs[1], compare(cpu, gpu), float(np.abs(gpu.backend.read("v")[0]).max())]
     # the margin: a kicked point in well 1 with a margin that allows none beyond well 0
     cpu, gpu = pair()
     for sim in (cpu, gpu):
         sim.loading.step(False)
         sim.loading.step(True)
-    ny = cpu.stack.model.epsy.shape[1]
-    out["margin"] = [sim.stack.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
+    ny = cpu.model.epsy.shape[1]
+    out["margin"] = [sim.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
     # a thermal load increment (kinetic Monte Carlo on the host, the hop's relaxation on the device)
     cpu, gpu = pair(relaxation="exact", quiet_steps=3, temperature=2e-3, drive_rate=1e-5)
     out["thermal"] = [[sim.protocol.step(False, 5, 1)] for sim in (cpu, gpu)]
@@ -169,8 +169,8 @@ def simulated(numba_cuda):
                          backend)  # exact: the linear response by one solve (the simulator is slow)
         sim.loading.step(False)
         sim.loading.step(True)
-        status = sim.stack.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
-        return [status] + [sim.stack.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx")]
+        status = sim.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
+        return [status] + [sim.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx")]
 
     from stickslip.fem.backends.cuda import batch as batch_module
     batch_module.STEPS_PER_LAUNCH = 2  # several launches per minimisation

@@ -157,8 +157,8 @@ def test_results_do_not_depend_on_the_number_of_threads():
         sim = Simulation(params, mesh, make_backend(params.backend, threads))
         sim.loading.step(kick=False)
         sim.loading.step(kick=True)
-        sim.stack.backend.advance(300)  # blocks yield during these steps
-        states.append(sim.stack.backend.read("u", "v", "a", "f", "idx", "sig"))
+        sim.backend.advance(300)  # blocks yield during these steps
+        states.append(sim.backend.read("u", "v", "a", "f", "idx", "sig"))
     set_num_threads(1)
     for name, one, two in zip(("u", "v", "a", "f", "idx", "sig"), *states):
         np.testing.assert_array_equal(one, two, err_msg=name)

@@ -126,14 +126,14 @@ def part_sanity(out):
     mesh = build_stack_mesh(MeshParams(N=N, plates=3))
     response = affine_response(params, mesh)
     cpu = _kicked(params, mesh, make_backend(), response)
-    cpu.stack.backend.advance(steps)
-    reference = cpu.stack.backend.read("u", "v", "idx")
+    cpu.backend.advance(steps)
+    reference = cpu.backend.read("u", "v", "idx")
     states = {}
     for groups in (1, 4, 16):
         start = time.perf_counter()
         gpu = _kicked(dataclasses.replace(params, backend="cuda"), mesh, CudaBackend(groups=groups), response)
-        gpu.stack.backend.advance(steps)
-        states[groups] = gpu.stack.backend.read("u", "v", "idx")
+        gpu.backend.advance(steps)
+        states[groups] = gpu.backend.read("u", "v", "idx")
         emit(out, part="sanity", groups=groups, seconds=time.perf_counter() - start,
              u_vs_cpu=float(np.abs(states[groups][0] - reference[0]).max() / np.abs(reference[0]).max()),
              wells_equal_cpu=bool(np.array_equal(states[groups][2], reference[2])))
@@ -207,11 +207,11 @@ def _speed(out, plates, sizes, groups_alone, steps):
     mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
     response = affine_response(dataclasses.replace(params, backend="structured"), mesh)
     sim = _kicked(params, mesh, CudaBackend(), response)
-    model = sim.stack.model
+    model = sim.model
     nelem = mesh.nelem
     state = sim.stack.stored()
     for count, groups in [(1, g) for g in groups_alone] + [(b, None) for b in sizes]:
-        batch = DeviceBatch(sim.stack.backend.batch.mesh, model.law, count, groups)
+        batch = DeviceBatch(sim.backend.batch.mesh, model.law, count, groups)
         members = [CudaBackend().bound(model, batch) for _ in range(count)]
         for member in members:
             member.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
@@ -247,7 +247,7 @@ def _events(out, backend_name, N, regime, count, groups=None):
     start = time.perf_counter()
     sim = Simulation(params, mesh, backend)
     setup = time.perf_counter() - start
-    dt = sim.stack.model.dt
+    dt = sim.model.dt
     steps, seconds, sizes = [], [], []
     for _ in range(count):
         sim.loading.step(False)
@@ -282,9 +282,9 @@ def part_cpu_step(out):
         params = FemParams(N=N, plates=plates, nchunk=200)
         mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
         sim = _kicked(params, mesh, make_backend(), affine_response(params, mesh))
-        sim.stack.backend.advance(20)
+        sim.backend.advance(20)
         start = time.perf_counter()
-        sim.stack.backend.advance(steps)
+        sim.backend.advance(steps)
         per_step = (time.perf_counter() - start) / steps
         emit(out, part="cpu-step", backend="structured", threads=1, N=N, plates=plates, elements=mesh.nelem,
              us_per_step=per_step * 1e6, element_steps_per_s=mesh.nelem / per_step)

@@ -92,7 +92,7 @@ def _create(path, params, mesh, backend, producer):
     simulation = Simulation(params, mesh, backend)
     observer = Observer(simulation)
     protocol = simulation.protocol
-    columns = observable_columns(observer.nlayer, observer.n_interfaces, simulation.stack.model.free_lever)
+    columns = observable_columns(observer.nlayer, observer.n_interfaces, simulation.model.free_lever)
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
             create_file(file, _header(simulation, observer, producer), mesh, simulation.loading.response,
