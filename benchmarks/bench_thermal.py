@@ -27,7 +27,7 @@ from stickslip.h5io import open_file
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.replay import EventReplay
 from stickslip.fem.thermal import drive_scale, energy_unit, sample_event
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.registry import get
 
 

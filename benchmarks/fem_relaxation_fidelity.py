@@ -66,7 +66,7 @@ from stickslip.fem.simulation import Simulation
 from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "nchunk": 200}
 

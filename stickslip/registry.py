@@ -2,7 +2,7 @@
 
 A plugin is one function plus its identity: name (a path component of its
 outputs), version (part of the run id: a new version reruns what it produced),
-a parameter dataclass (see :mod:`stickslip.params`) and its contract: the
+a parameter dataclass (see :mod:`stickslip.plugin_params`) and its contract: the
 artifact formats it consumes and produces (:mod:`stickslip.formats`); a figure
 declares the input categories it reads. The study wires stages by format, never
 by plugin name: an analysis that consumes ``fem-run`` runs on the output of every
@@ -45,7 +45,7 @@ from importlib.metadata import entry_points
 from . import formats
 from .h5io import FileFormatError
 from .hashing import short_hash
-from .params import params_to_dict
+from .plugin_params import params_to_dict
 
 __all__ = [
     "KINDS",
@@ -115,7 +115,7 @@ class Plugin:
     replay : Callable or None
         Solvers: ``replay(path)`` re-runs stored events of a file the solver wrote.
     preflight : Callable or None
-        Solvers: ``preflight(params)`` raises :class:`stickslip.params.ParameterError` if this machine cannot
+        Solvers: ``preflight(params)`` raises :class:`stickslip.plugin_params.ParameterError` if this machine cannot
         make the run (e.g. a GPU backend without a GPU); called before any output is claimed or written.
     module : str
         Module that defined it.

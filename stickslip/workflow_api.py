@@ -40,7 +40,7 @@ from .h5io import FileFormatError, open_file
 from .hashing import sha256_file
 from .lineage import Artifact
 from .output_safety.overwrite import refuse_other_run
-from .params import params_to_dict, parse_params
+from .plugin_params import params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import read_record, recording
 from .termination import interrupts_raised
@@ -198,7 +198,7 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         Simulation file (HDF5), its provenance record, the log.
     inputs : str or Mapping
         Upstream files by consumed format, as artifacts (``{"mesh": Artifact}``), or
-        their JSON (:meth:`stickslip.study.Study.dumps`).
+        their JSON (:meth:`stickslip.study_plan.Study.dumps`).
     threads : int
         Threads of the parallel kernels.
     numba_cache : {"shared", "job"}

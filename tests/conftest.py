@@ -15,7 +15,7 @@ from stickslip import registry
 from stickslip.formats.fem_run import read_increments
 from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
-from stickslip.study import Study
+from stickslip.study_plan import Study
 
 REPO = Path(__file__).resolve().parent.parent
 TOY = Path(__file__).resolve().parent / "toy_plugin" / "stickslip_toy.py"
@@ -133,7 +133,7 @@ def toy_results(tmp_path, toy_plugins, monkeypatch):
     list[pathlib.Path]
         The provenance records, relative to the working directory ``tmp_path``.
     """
-    from stickslip.params import parse_params
+    from stickslip.plugin_params import parse_params
     from stickslip.workflow_api import run_analysis, run_figure, run_simulation
 
     monkeypatch.chdir(tmp_path)
@@ -172,7 +172,7 @@ def fem_reference_run(tmp_path_factory):
     Shared by tests/test_fem_reference.py and tests/test_fem_kill.py, which compare their own runs of the
     case with it byte for byte.
     """
-    from stickslip.params import parse_params
+    from stickslip.plugin_params import parse_params
 
     path = tmp_path_factory.mktemp("fem-reference") / "run.h5"
     plugin = registry.get("solver", "fem")

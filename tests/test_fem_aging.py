@@ -36,7 +36,7 @@ from stickslip.fem.thermal.redraws import REDRAW, sample_with_redraws
 from stickslip.fem.thermal.sampler import NONE, THRESHOLD
 from stickslip.formats.fem_run import RunFile, describe, read_increments, read_run_attrs
 from stickslip.h5io import write_attrs
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from stickslip.registry import get, run_id
 from stickslip.solvers.fem import stack_mesh
 

@@ -16,7 +16,7 @@ from stickslip.fem.parameters import FemParams
 from stickslip.fem.run import run_simulation
 from stickslip.fem.simulation import Simulation
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import params_to_dict, parse_params
+from stickslip.plugin_params import params_to_dict, parse_params
 
 
 @pytest.mark.slow

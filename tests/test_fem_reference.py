@@ -21,7 +21,7 @@ from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.numba_options import set_num_threads
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
 

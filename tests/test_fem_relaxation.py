@@ -16,7 +16,7 @@ from stickslip.fem.protocol import AthermalProtocol
 from stickslip.fem.simulation import Simulation
 from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "drive": "fixed-lever", "nchunk": 200}
 

@@ -62,7 +62,7 @@ PRELUDE = """
     from stickslip.fem.parameters import FemParams
     from stickslip.fem.simulation import Simulation
     from stickslip.mesh import MeshParams, build_stack_mesh
-    from stickslip.params import ParameterError, parse_params
+    from stickslip.plugin_params import ParameterError, parse_params
 
     def events(sim, count):
         rows = []

@@ -18,7 +18,7 @@ import warnings
 
 from ..h5io import FileFormatError
 from ..output_safety.errors import OutputError
-from ..params import ParameterError, ParameterWarning
+from ..plugin_params import ParameterError, ParameterWarning
 from ..registry import PluginError
 from ..termination import exit_status, interrupts_raised, interruption
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..h5io import FileFormatError
-from ..params import ParameterError, parse_assignments
+from ..plugin_params import ParameterError, parse_assignments
 from ..provenance.filters import EVENT_FILTERS, RUN_FILTERS
 from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
 from ..workdir import ENVIRONMENT, find_workdir
@@ -41,7 +41,7 @@ EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regi
 
 def _study(name):
     """``--study``: a study's name, a directory under results/ (``..`` or a path would leave it)."""
-    from ..study import check_study_name
+    from ..study_plan import check_study_name
 
     try:
         return check_study_name(name, "a study name")

@@ -51,7 +51,7 @@ from ..experiment.aging import aging_rate, slow_slip_fraction
 from ..formats.analysis_file import write_analysis_file
 from ..formats.event_table import slip_events_table
 from ..h5io import FileFormatError
-from ..params import param
+from ..plugin_params import param
 from ..registry import register
 from . import extraction
 from .aging_trials import aftershock_tables, trial_slip_table

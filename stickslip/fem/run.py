@@ -31,7 +31,7 @@ from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
 from ..output_safety.overwrite import changed_values, set_aside
 from ..output_safety.space import check_free_space
-from ..params import params_to_dict
+from ..plugin_params import params_to_dict
 from .backends import backend_arithmetic
 from .observables import Observer, observable_columns
 from .parameters import stored_params

@@ -328,7 +328,7 @@ def _parameters(names):
     import dataclasses
 
     from .. import registry
-    from ..params import parse_value
+    from ..plugin_params import parse_value
 
     found = {}
     for kind in registry.KINDS:
@@ -389,7 +389,7 @@ def runs(database=DEFAULT_DATABASE, **filters):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         A filter that does not exist or a value that does not fit it (one line naming it).
 
     Notes
@@ -430,7 +430,7 @@ def events(database=DEFAULT_DATABASE, **filters):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         A filter that does not exist or a value that does not fit it.
 
     Notes

@@ -51,7 +51,7 @@ def stack_mesh(params, inputs):
 
 
 def can_run(params):
-    """Raise :class:`stickslip.params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
+    """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
     make_backend(params.backend)
 
 

@@ -1,5 +1,5 @@
 # The study: the config validated (each plugin section against its plugin's JSON-Schema, defaults
-# filled) and expanded into jobs by stickslip.study before any rule is defined.
+# filled) and expanded into jobs by stickslip.study_plan before any rule is defined.
 
 import re
 import tempfile
@@ -9,10 +9,10 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from stickslip.params import ParameterError, did_you_mean
+from stickslip.plugin_params import ParameterError, did_you_mean
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
-from stickslip.study import Study, check_sweeps, normalise, plugin_sections
+from stickslip.study_plan import Study, check_sweeps, normalise, plugin_sections
 
 
 def _validate(section, schema, key):

@@ -37,7 +37,7 @@ from pathlib import Path
 from . import registry
 from .hashing import short_hash
 from .lineage import Artifact
-from .params import ParameterError, json_schema, params_to_dict, parse_params
+from .plugin_params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import record_path
 
@@ -268,7 +268,7 @@ def plugin_sections(config):
         ``(key, section, schema)``: ``key`` names the section in messages (e.g.
         ``solvers.lever[0].grid``); ``section`` is the mapping itself (a schema
         validator that fills defaults changes it in place); ``schema`` comes from
-        :func:`stickslip.params.json_schema` of the plugin's parameter class.
+        :func:`stickslip.plugin_params.json_schema` of the plugin's parameter class.
 
     Raises
     ------
