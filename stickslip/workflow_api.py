@@ -217,11 +217,12 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
 
 def run_simulation_batch(solver, params_jsons, outputs, records, log, *, inputs, threads, numba_cache="shared",
                          module=None):
-    """Run several runs of one solver as one batch on a GPU (``backend = cuda``): one job, one file per run.
+    """Run several runs of one solver as one batch on a device: one job, one file per run.
 
     Every run is as :func:`run_simulation` makes it (its file, its provenance record, resumed or left
     alone as there); the runs not completed before advance together, one thread each, their
-    minimisations sharing the device's launches (:func:`stickslip.fem.backends.cuda.run_ensemble`).
+    minimisations sharing the device's launches (the solver's ``device_batch``,
+    :class:`stickslip.registry.DeviceBatching`).
 
     Parameters
     ----------
@@ -237,14 +238,16 @@ def run_simulation_batch(solver, params_jsons, outputs, records, log, *, inputs,
     """
     prepare_environment(threads, numba_cache)
     with _logged(log):
-        from .fem.backends.cuda import run_ensemble
-        from .numba_options import set_num_threads
+        from .numba_options import set_num_threads  # after prepare_environment: numba reads its threads on import
 
+        batching = registry.get("solver", registry.config_key(solver)[0], module).device_batch
+        if batching is None:
+            raise registry.PluginError(f"solver {solver!r} declares no device_batch: its runs are one job each")
         jobs = [_solver_job(solver, *job, module) for job in zip(params_jsons, outputs, records, inputs)]
         pending = [job for job in jobs if job is not None]
         used = set_num_threads(threads)
         print(f"batch of {len(jobs)} runs, {len(jobs) - len(pending)} completed before")
-        run_ensemble([lambda backend, job=job: _run_solver_job(job, used, backend) for job in pending])
+        batching.run([lambda backend, job=job: _run_solver_job(job, used, backend) for job in pending])
 
 
 def _solver_job(solver, params_json, output, record, inputs, module):

@@ -89,14 +89,13 @@ def with_gpu_rule_resources(name):
 
 
 onstart:
-    # A local run with jobs on a GPU (fem, backend cuda) checks, before any job, that this machine can run them.
+    # A local run with jobs on a GPU (a solver's device_batch picks them) checks, before any job, that this machine
+    # can run them.
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "local":
         gpu_jobs = [job for job in workflow.dag.needrun_jobs() if job.resources.get("gpu")]
         if gpu_jobs:
-            from stickslip.fem.backends import make_backend
-
             try:
-                make_backend("cuda")
+                STUDY.check_device_runs()
             except ParameterError as error:
                 raise WorkflowError(f"{len(gpu_jobs)} job(s) run on a GPU ({gpu_jobs[0].rule.name}, ...): "
                                     f"{error}") from None
