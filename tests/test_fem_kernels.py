@@ -208,7 +208,7 @@ def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells
     # vectorised kernel, with displacements large enough that many points change well (the
     # recompute path)
     backend = Simulation(FemParams(N=9, plates=3, nchunk=50, interface_law=law),
-                         build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).stack.backend
+                         build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).backend
     model, state = backend.model, new_state(backend.model)
     assert model.law.name == law
     rng = np.random.default_rng(3)
