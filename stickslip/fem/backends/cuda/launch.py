@@ -1,0 +1,139 @@
+"""How a batch's kernels are launched: threads per block, blocks per realisation, co-residency, errors.
+
+A realisation spread over ``G > 1`` blocks waits at barriers for all of them, so all blocks of a launch
+must be resident on the device at once: :meth:`Launcher.groups_for` asks the compiled kernel how many
+blocks the device holds at once (its occupancy: ``max_cooperative_grid_blocks``) and never launches more
+than that with ``G > 1``; ``G = 1`` (a block per realisation) waits for no other block and needs no
+such bound. Should a block still not arrive (another program on the device), the barrier's deadline
+ends the launch and :class:`BarrierTimeout` is raised, never a hang.
+"""
+
+import collections
+import threading
+
+import numba
+import numpy as np
+from numba import config, cuda
+
+from .kernels import kernels_for
+from .minimise import RUNNING
+from .records import Launch
+from .sync import BARRIER_TIMEOUT
+
+__all__ = ["Launcher", "BarrierTimeout", "LAUNCHES", "STEPS_PER_LAUNCH", "DEADLINE_CYCLES", "threads_per_block"]
+
+#: Time steps of one launch of a minimisation at most (then the host reads the status words and relaunches).
+STEPS_PER_LAUNCH = 4096
+
+#: Clock cycles a block waits at a barrier before it gives up (about 10 s at 2 GHz; ns on the simulator).
+DEADLINE_CYCLES = 20_000_000_000
+
+#: Held around every launch: an ensemble's runs launch from their own threads (numba's simulator executes a
+#: launch in the caller and is not safe for launches from two threads at once).
+LAUNCHES = threading.RLock()
+
+
+class BarrierTimeout(RuntimeError):
+    """The blocks of a realisation did not all meet at a barrier within the deadline."""
+
+
+def threads_per_block(tile):
+    """Threads of a block: one per node of a tile on a GPU; 8 on numba's simulator (each a Python thread)."""
+    return min(8, tile) if config.ENABLE_CUDASIM else tile
+
+
+class Launcher:
+    """The launches of one batch's kernels.
+
+    Parameters
+    ----------
+    mesh : .device.DeviceMesh
+    law : tuple
+        The law of the batch (it chooses the kernels).
+    groups : int, optional
+        Blocks per realisation of a minimisation at most (default: as many as there are tiles and the
+        device holds at once).
+    deadline : int, optional
+        Clock cycles of a barrier's wait.
+
+    Attributes
+    ----------
+    groups_used : collections.Counter
+        Launches of the minimisation kernel by blocks per realisation.
+    """
+
+    def __init__(self, mesh, law, groups=None, deadline=DEADLINE_CYCLES):
+        self.mesh, self.law, self.groups, self.deadline = mesh, law, groups, int(deadline)
+        self.kernels = kernels_for(type(law).name)
+        self.block = threads_per_block(mesh.layout.tile)
+        self.groups_used = collections.Counter()
+        self._capacity = None
+
+    def record(self, slots, groups=1, nsteps=0, update_wells=True):
+        """The :class:`.records.Launch` of ``slots``."""
+        members = self.mesh.place(np.asarray(slots, dtype=np.int64))
+        return Launch(members, int(groups), int(nsteps), self.deadline, self.mesh.dt, self.mesh.free_lever,
+                      bool(update_wells))
+
+    def co_resident(self, arguments):
+        """Blocks of the minimisation kernel the device holds at once (asked of the compiled kernel once)."""
+        if self._capacity is None:
+            kernel = self.kernels.minimise
+            if config.ENABLE_CUDASIM:
+                compiled = kernel.overloads[None]
+            else:
+                compiled = kernel.compile(tuple(numba.typeof(argument) for argument in arguments))
+            self._capacity = int(compiled.max_cooperative_grid_blocks(self.block))
+        return self._capacity
+
+    def groups_for(self, count, arguments):
+        """Blocks per realisation for a launch of ``count`` realisations: all co-resident if more than one."""
+        ntile = self.mesh.layout.ntile
+        wanted = min(self.groups or ntile, ntile)
+        return max(1, min(wanted, self.co_resident(arguments) // count))
+
+    def minimise(self, slots, state, nsteps=STEPS_PER_LAUNCH):
+        """One launch of the minimisation kernel for ``slots``; their status words afterwards.
+
+        Raises
+        ------
+        BarrierTimeout
+            If a realisation's blocks did not meet at a barrier.
+        """
+        with LAUNCHES:
+            arguments = [self.law, self.record(slots, 1, nsteps), self.mesh.layout, state.record(),
+                         state.control_record()]
+            G = self.groups_for(len(slots), arguments)
+            arguments[1] = arguments[1]._replace(groups=G)
+            state.reset_counters()
+            self.kernels.minimise[len(slots) * G, self.block](*arguments)
+            self.groups_used[G] += 1
+        status = state.control["status"].copy_to_host()
+        failed = [slot for slot in slots if status[slot] == BARRIER_TIMEOUT]
+        if failed:
+            raise BarrierTimeout(f"cuda: the {G} blocks of realisation(s) {failed} did not meet at a barrier within "
+                                 f"{self.deadline} clock cycles (blocks not resident together, or another program "
+                                 "holds the device)")
+        return {slot: int(status[slot]) for slot in slots}
+
+    def per_tile(self, name, slots, state, law=False, update_wells=True):
+        """Launch kernel ``name`` with one block per (slot, tile)."""
+        head = (self.law,) if law else ()
+        with LAUNCHES:
+            getattr(self.kernels, name)[len(slots) * self.mesh.layout.ntile, self.block](
+                *head, self.record(slots, update_wells=update_wells), self.mesh.layout, state.record())
+
+    def per_slot(self, name, slots, state, *extra):
+        """Launch kernel ``name`` with one block per slot."""
+        with LAUNCHES:
+            getattr(self.kernels, name)[len(slots), self.block](self.record(slots), self.mesh.layout, state.record(),
+                                                                 *extra)
+
+    def per_item(self, name, slot, count, *arguments):
+        """Launch kernel ``name`` for ``count`` items of ``slot`` (one thread each)."""
+        with LAUNCHES:
+            getattr(self.kernels, name)[max(1, -(-count // self.block)), self.block](slot, *arguments)
+
+    def running(self, status):
+        """Whether a status word says the minimisation goes on."""
+        return status == RUNNING
