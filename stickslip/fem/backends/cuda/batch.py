@@ -20,7 +20,7 @@ from .state import DeviceState
 
 __all__ = ["DeviceBatch", "EVENT_CAPACITY"]
 
-#: Rows of a recording slot's event buffer at first, beyond 8 per interface element (grown when a step needs more).
+#: Rows of a recording slot's event buffer at first (emptied when full, grown when one step needs more).
 EVENT_CAPACITY = 1 << 16
 
 
@@ -74,7 +74,7 @@ class DeviceBatch:
     def evaluate(self, slot, update_wells):
         """Everything that follows from the slot's displacement and drive; returns its residual."""
         self.launcher.per_tile("layer_sums", [slot], self.state)
-        self.launcher.per_tile("evaluate", [slot], self.state, law=True, update_wells=update_wells)
+        self.launcher.per_tile("evaluate", [slot], self.state, update_wells=update_wells)
         self.launcher.per_slot("residual", [slot], self.state)
         return float(self.state.arrays["scalar"][slot])
 
@@ -91,12 +91,12 @@ class DeviceBatch:
     def add_u(self, slot, dofs, delta):
         """``u[dofs] += delta`` of the slot (then :meth:`evaluate`)."""
         dofs = np.asarray(dofs, dtype=np.int64)
-        self.launcher.per_item("add_u", slot, dofs.size, self.mesh.place(dofs),
-                               self.mesh.place(np.asarray(delta, dtype=np.float64)), self.state.record())
+        self.launcher.per_item("add_u", slot, dofs.size, self.state, self.mesh.place(dofs),
+                               self.mesh.place(np.asarray(delta, dtype=np.float64)))
 
     def stop(self, slot):
         """``v = a = 0`` in the slot."""
-        self.launcher.per_item("zero_motion", slot, self.mesh.layout.ndof, self.state.record())
+        self.launcher.per_item("zero_motion", slot, self.mesh.layout.ndof, self.state)
 
     def wells_hold(self, slot):
         """True if every Gauss point of the slot lies in its held well."""
@@ -109,8 +109,8 @@ class DeviceBatch:
         with LAUNCHES:  # no launch uses the yield strains while they are replaced
             self.state.hold_yield_strains(slot, epsy)
         if shift is not None:
-            self.launcher.per_item("shift_wells", slot, epsy.shape[0], self.mesh.place(np.asarray(shift, np.int64)),
-                                   self.state.record())
+            self.launcher.per_item("shift_wells", slot, epsy.shape[0], self.state,
+                                   self.mesh.place(np.asarray(shift, np.int64)))
 
     def checkpoint(self, slot):
         """Device copies of the slot's state."""
@@ -155,7 +155,7 @@ class DeviceBatch:
         tol, niter_tol, max_iter, margin, record, quiet = criteria
         if record:
             with LAUNCHES:
-                self.state.grow_events(EVENT_CAPACITY + 8 * self.mesh.layout.ni)
+                self.state.grow_events(EVENT_CAPACITY)
         self.state.upload(slot, tol=tol, niter_tol=niter_tol, max_iter=max_iter, margin=margin, record=int(record),
                           quiet=quiet, done=0, judged=1, status=RUNNING, needed=0, runs=np.zeros(4, np.int64),
                           last=np.inf, nevent=0, previous=self.state.read(slot, ("idx",))[0][:, 0])

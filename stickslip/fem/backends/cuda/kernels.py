@@ -55,14 +55,16 @@ def _placed(launch, ntile):
 def _small_kernels(device, items, sync, tiles, drive):
     """The kernels besides ``minimise`` (module docstring), as plain functions."""
     placed, equivalent, well, tile_sums = device(_placed), items.equivalent, items.well, sync.tile_sums
+    load_stencils, elements, publish = tiles.load_stencils, tiles.elements, tiles.publish
+    state_rows, force_nodes = tiles.state_rows, tiles.force_nodes
 
     def prime(launch, mesh, state):
         m, k = placed(launch, mesh.ntile)
         rows = cuda.shared.array((ROWS, MAX_TILE), float64)
         nrows = LAYER_ROW + mesh.nlayer
         t, bd = cuda.threadIdx.x, cuda.blockDim.x
-        tiles.state_rows(mesh, k, m, state.u[m, 0], state.u[m, 1], state, launch.dt, True, rows, nrows, t, bd)
-        tiles.publish(rows, nrows, mesh.tile, state.partials[m, 0, k], t, bd)
+        state_rows(mesh, k, m, state.u[m, 0], state.u[m, 1], state, launch.dt, True, rows, nrows, t, bd)
+        publish(rows, nrows, mesh.tile, state.partials[m, 0, k], t, bd)
         for j in range(t, 3, bd):
             state.flags[m, 0, k, j] = 0
 
@@ -71,8 +73,8 @@ def _small_kernels(device, items, sync, tiles, drive):
         rows = cuda.shared.array((ROWS, MAX_TILE), float64)
         nrows = LAYER_ROW + mesh.nlayer
         t, bd = cuda.threadIdx.x, cuda.blockDim.x
-        tiles.state_rows(mesh, k, m, state.u[m, 0], state.u[m, 0], state, launch.dt, False, rows, nrows, t, bd)
-        tiles.publish(rows, nrows, mesh.tile, state.partials[m, 0, k], t, bd)
+        state_rows(mesh, k, m, state.u[m, 0], state.u[m, 0], state, launch.dt, False, rows, nrows, t, bd)
+        publish(rows, nrows, mesh.tile, state.partials[m, 0, k], t, bd)
 
     def evaluate(law, launch, mesh, state):
         m, k = placed(launch, mesh.ntile)
@@ -88,11 +90,11 @@ def _small_kernels(device, items, sync, tiles, drive):
         t, bd = cuda.threadIdx.x, cuda.blockDim.x
         tile_sums(state.partials[m, 0], mesh.ntile, LAYER_ROW, mesh.nlayer, leaves, t, bd)
         drive(launch, mesh, state, m, leaves, drive_out)
-        tiles.load_stencils(mesh, k, coef, target, t, bd)
-        tiles.elements(law, mesh, k, state.u[m, 0], state, m, fe, flags, launch.update_wells, state.ny[m] + 1, False,
+        load_stencils(mesh, k, coef, target, t, bd)
+        elements(law, mesh, k, state.u[m, 0], state, m, fe, flags, launch.update_wells, state.ny[m] + 1, False,
                        t, bd, ue, strain)
-        tiles.force_nodes(mesh, k, m, state.u[m, 0], state, coef, target, fe, drive_out[1], rows, t, bd)
-        tiles.publish(rows, LAYER_ROW, mesh.tile, state.partials[m, 1, k], t, bd)
+        force_nodes(mesh, k, m, state.u[m, 0], state, coef, target, fe, drive_out[1], rows, t, bd)
+        publish(rows, LAYER_ROW, mesh.tile, state.partials[m, 1, k], t, bd)
         if k == 0 and t == 0:
             for layer in range(mesh.nlayer):
                 state.ubar[m, layer] = drive_out[0, layer]
@@ -103,8 +105,8 @@ def _small_kernels(device, items, sync, tiles, drive):
         m, k = placed(launch, mesh.ntile)
         rows = cuda.shared.array((ROWS, MAX_TILE), float64)
         t, bd = cuda.threadIdx.x, cuda.blockDim.x
-        tiles.state_rows(mesh, k, m, state.u[m, 0], state.u[m, 0], state, launch.dt, False, rows, LAYER_ROW, t, bd)
-        tiles.publish(rows, LAYER_ROW, mesh.tile, state.partials[m, 1, k], t, bd)
+        state_rows(mesh, k, m, state.u[m, 0], state.u[m, 0], state, launch.dt, False, rows, LAYER_ROW, t, bd)
+        publish(rows, LAYER_ROW, mesh.tile, state.partials[m, 1, k], t, bd)
 
     def residual(launch, mesh, state):
         m = launch.members[cuda.blockIdx.x]

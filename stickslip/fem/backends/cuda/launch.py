@@ -16,7 +16,6 @@ import numpy as np
 from numba import config, cuda
 
 from .kernels import kernels_for
-from .minimise import RUNNING
 from .records import Launch
 from .sync import BARRIER_TIMEOUT
 
@@ -54,7 +53,7 @@ class Launcher:
         Blocks per realisation of a minimisation at most (default: as many as there are tiles and the
         device holds at once).
     deadline : int, optional
-        Clock cycles of a barrier's wait.
+        Clock cycles of a barrier's wait (default :data:`DEADLINE_CYCLES`).
 
     Attributes
     ----------
@@ -62,8 +61,9 @@ class Launcher:
         Launches of the minimisation kernel by blocks per realisation.
     """
 
-    def __init__(self, mesh, law, groups=None, deadline=DEADLINE_CYCLES):
-        self.mesh, self.law, self.groups, self.deadline = mesh, law, groups, int(deadline)
+    def __init__(self, mesh, law, groups=None, deadline=None):
+        self.mesh, self.law, self.groups = mesh, law, groups
+        self.deadline = int(DEADLINE_CYCLES if deadline is None else deadline)
         self.kernels = kernels_for(type(law).name)
         self.block = threads_per_block(mesh.layout.tile)
         self.groups_used = collections.Counter()
@@ -92,8 +92,21 @@ class Launcher:
         wanted = min(self.groups or ntile, ntile)
         return max(1, min(wanted, self.co_resident(arguments) // count))
 
-    def minimise(self, slots, state, nsteps=STEPS_PER_LAUNCH):
-        """One launch of the minimisation kernel for ``slots``; their status words afterwards.
+    def arguments(self, name, slots, state, nsteps=0, update_wells=True, extra=()):
+        """The arguments of a launch of kernel ``name`` for ``slots`` (also for compiling without a device).
+
+        Kernels of a launch record take ``(law?, launch, mesh, state, control?)`` and then ``extra``; the
+        kernels of one slot's items (``add_u``, ``shift_wells``, ``zero_motion``) take ``(slot, *extra, state)``.
+        """
+        if name in ("add_u", "shift_wells", "zero_motion"):
+            return (int(slots[0]), *extra, state.record())
+        head = (self.law,) if name in ("minimise", "evaluate") else ()
+        tail = (state.control_record(),) if name == "minimise" else ()
+        return (*head, self.record(slots, 1, nsteps, update_wells), self.mesh.layout, state.record(), *tail, *extra)
+
+    def minimise(self, slots, state, nsteps=None):
+        """One launch of at most ``nsteps`` (default :data:`STEPS_PER_LAUNCH`) time steps of the minimisation kernel
+        for ``slots``; their status words afterwards.
 
         Raises
         ------
@@ -101,8 +114,7 @@ class Launcher:
             If a realisation's blocks did not meet at a barrier.
         """
         with LAUNCHES:
-            arguments = [self.law, self.record(slots, 1, nsteps), self.mesh.layout, state.record(),
-                         state.control_record()]
+            arguments = list(self.arguments("minimise", slots, state, STEPS_PER_LAUNCH if nsteps is None else nsteps))
             G = self.groups_for(len(slots), arguments)
             arguments[1] = arguments[1]._replace(groups=G)
             state.reset_counters()
@@ -116,24 +128,19 @@ class Launcher:
                                  "holds the device)")
         return {slot: int(status[slot]) for slot in slots}
 
-    def per_tile(self, name, slots, state, law=False, update_wells=True):
+    def per_tile(self, name, slots, state, update_wells=True):
         """Launch kernel ``name`` with one block per (slot, tile)."""
-        head = (self.law,) if law else ()
         with LAUNCHES:
             getattr(self.kernels, name)[len(slots) * self.mesh.layout.ntile, self.block](
-                *head, self.record(slots, update_wells=update_wells), self.mesh.layout, state.record())
+                *self.arguments(name, slots, state, update_wells=update_wells))
 
     def per_slot(self, name, slots, state, *extra):
         """Launch kernel ``name`` with one block per slot."""
         with LAUNCHES:
-            getattr(self.kernels, name)[len(slots), self.block](self.record(slots), self.mesh.layout, state.record(),
-                                                                 *extra)
+            getattr(self.kernels, name)[len(slots), self.block](*self.arguments(name, slots, state, extra=extra))
 
-    def per_item(self, name, slot, count, *arguments):
+    def per_item(self, name, slot, count, state, *extra):
         """Launch kernel ``name`` for ``count`` items of ``slot`` (one thread each)."""
         with LAUNCHES:
-            getattr(self.kernels, name)[max(1, -(-count // self.block)), self.block](slot, *arguments)
-
-    def running(self, status):
-        """Whether a status word says the minimisation goes on."""
-        return status == RUNNING
+            getattr(self.kernels, name)[max(1, -(-count // self.block)), self.block](
+                *self.arguments(name, [slot], state, extra=extra))

@@ -39,6 +39,7 @@ ROWS = LAYER_ROW + MAX_LAYERS
 def build(device, items, sync, tiles):
     """The minimisation kernel (plain function; :func:`numba.cuda.jit` compiles it) and its drive function."""
     barrier, tile_sums = sync.barrier, sync.tile_sums
+    load_stencils, elements, step_nodes, publish = tiles.load_stencils, tiles.elements, tiles.step_nodes, tiles.publish
 
     @device
     def drive(launch, mesh, state, m, leaves, out):
@@ -217,13 +218,13 @@ def build(device, items, sync, tiles):
             u, u_next = state.u[m, parity], state.u[m, 1 - parity]
             time += launch.dt
             for k in range(part, mesh.ntile, G):
-                tiles.load_stencils(mesh, k, coef, target, t, bd)
-                tiles.elements(law, mesh, k, u, state, m, fe, flags, True, limit, control.record[m], t, bd, ue, strain)
-                tiles.step_nodes(mesh, k, m, u, u_next, state, launch.dt, coef, target, fe, drive_out[1], rows, nrows,
+                load_stencils(mesh, k, coef, target, t, bd)
+                elements(law, mesh, k, u, state, m, fe, flags, True, limit, control.record[m], t, bd, ue, strain)
+                step_nodes(mesh, k, m, u, u_next, state, launch.dt, coef, target, fe, drive_out[1], rows, nrows,
                                  t, bd)
-                tiles.publish(rows, nrows, mesh.tile, state.partials[m, parity, k], t, bd)
                 for j in range(t, 3, bd):
                     state.flags[m, parity, k, j] = flags[j]
+                publish(rows, nrows, mesh.tile, state.partials[m, parity, k], t, bd)
             passed = barrier(control.counter, m, G, passed, launch.deadline, shared)
             if passed < 0:
                 verdict = BARRIER_TIMEOUT

@@ -25,7 +25,8 @@ BARRIER_TIMEOUT = 5
 
 if config.ENABLE_CUDASIM:
     def cycles():
-        """The clock the deadline counts (on the simulator: nanoseconds)."""
+        """The clock the deadline counts (on the simulator: nanoseconds; a call yields to the other threads)."""
+        time.sleep(0)
         return time.perf_counter_ns()
 else:
     from llvmlite import ir

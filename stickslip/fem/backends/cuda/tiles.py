@@ -88,6 +88,7 @@ def build(device, items, sync):
         tile_tree(rows, nrows, tile, t, bd)
         for r in range(t, nrows, bd):
             partials[r] = rows[r, 0]
+        cuda.syncthreads()  # the rows are read before the next tile writes them
 
     def step_nodes(mesh, k, m, u, u_next, state, dt, coef, target, fe, scale, rows, nrows, t, bd):
         """One time step of tile ``k``'s nodes, fused: force, velocity Verlet, residual terms, next displacement."""
