@@ -101,27 +101,34 @@ def test_a_realisation_spread_over_three_blocks_gives_the_bytes_of_one_block():
 
 
 def test_blocks_per_realisation_change_between_launches_while_runs_leave():
-    # three runs of an ensemble on a device that holds 6 blocks: 3 realisations x 2 blocks, then (one run ended)
-    # 2 x 3 blocks; launches of 2 steps, so every minimisation spans launches with both spreads
+    # three runs of an ensemble on a device that holds 6 blocks, launches of 2 steps: the first launch spreads the
+    # 3 realisations over 2 blocks each; one run then ends, and the next launch spreads the other two over 3
+    # blocks, in the middle of their residual criterion's window of 3 steps (they converge at step 3)
     result = _run("""
     launch_module.STEPS_PER_LAUNCH = 2
-    steps = {1: 2, 2: 4, 3: 6}
 
-    def run(seed, backend):
-        sim = kicked(backend, seed, 6e-3)
-        status = sim.stack.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
-        return [list(status), state(sim), groups(sim)]
+    def converging(seed, backend):
+        params = FemParams(**VALUES, seed=seed, relaxation="exact", backend=backend.name)
+        sim = Simulation(params, MESH, backend, response=RESPONSE)
+        solved = sim.relaxation.solve_in_wells(sim.stack.backend)  # its Newton iterations on the device
+        status = sim.stack.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2]
+        return [solved, list(status), state(sim), groups(sim)]
 
+    def ending(backend):
+        sim = kicked(backend, 3, 6e-3)
+        return [True, list(sim.stack.backend.minimise(1e-5, 20, 2, 0, False, 0)[:2]), state(sim), groups(sim)]
+
+    runs = [lambda backend: converging(1, backend), lambda backend: converging(2, backend), ending]
     with concurrent_blocks(6):
-        alone = [run(seed, CudaBackend()) for seed in steps]
-        together = run_ensemble([lambda backend, seed=seed: run(seed, backend) for seed in steps])
+        alone = [run(CudaBackend()) for run in runs]
+        together = run_ensemble(runs)
     print(json.dumps({"alone": alone, "together": together}))
     """)
     alone, together = result["alone"], result["together"]
-    assert [a[0] for a in alone] == [[-1, 2], [-1, 4], [-1, 6]]
-    assert [a[:2] for a in alone] == [t[:2] for t in together]  # every member's bytes as alone
-    assert set(together[2][2]) == {"2", "3"}  # the last run was spread over 2 blocks, then over 3
-    assert all(a[2] == {"3": n} for a, n in zip(alone, (1, 2, 3)))
+    assert [a[:2] for a in alone] == [[True, [1, 3]], [True, [1, 3]], [True, [-1, 2]]]
+    assert [a[:3] for a in alone] == [t[:3] for t in together]  # every member's bytes as alone
+    assert [t[3] for t in together] == [{"2": 1, "3": 1}, {"2": 1, "3": 1}, {"2": 1}]
+    assert [a[3] for a in alone] == [{"3": 2}, {"3": 2}, {"3": 1}]
 
 
 def test_an_event_buffer_that_a_step_overflows_is_emptied_and_grown_not_dropped():
