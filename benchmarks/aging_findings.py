@@ -51,7 +51,8 @@ def runs_summary(runs, study):
               f"{run['drive_rate']:g}, seed {run['seed']}: {len(events)} events ({hops} hops, {redrawn} redraw events, "
               f"{len(events) - hops - redrawn} athermal kicks), "
               f"{int(table['redraws'].sum()) if 'redraws' in table else 0} junction redraws, {len(slips)} steady-state "
-              f"slips, peak {fmt(*mean_sem(slips['mu_before'])[:2], 3)}, drop {fmt(*mean_sem(slips['dmu'])[:2], 3)} sig0")
+              f"slips, peak {fmt(*mean_sem(slips['mu_before_sig0'])[:2], 3)}, drop "
+              f"{fmt(*mean_sem(slips['dmu_sig0'])[:2], 3)} sig0")
 
 
 def holds_summary(runs):
@@ -88,7 +89,7 @@ def holds_summary(runs):
           + f"; slope {fmt(slope, error)} sig0 per e-fold of rate (negative: velocity weakening, a - b < 0)")
     off = select_runs(runs, n=1, temperature=1e-3, strengthening=0.0, drive_rate=2e-8)
     if len(off):
-        peaks = np.concatenate([item.tables["slip_events"]["mu_before"].to_numpy() for item in off["data"]])
+        peaks = np.concatenate([item.tables["slip_events"]["mu_before_sig0"].to_numpy() for item in off["data"]])
         print(f"- aging off at 2e-8: steady-state peak {fmt(*mean_sem(peaks)[:2], 3)} ({len(peaks)} slips)")
 
 
@@ -117,7 +118,7 @@ def estimator_summary(runs, every):
                 continue
             slips = pd.concat([item.tables["slip_events"].assign(seed=seed) for item, seed in
                                zip(chosen["data"], chosen["seed"])], ignore_index=True)
-            pooled.append(slips.rename(columns={"interface": "a"}).assign(n=n, protocol="stack"))
+            pooled.append(slips.rename(columns={"B_a_sig0": "B_a"}).assign(n=n, protocol="stack"))
             T0 = float(chosen["T0"].iloc[0])
             peaks = trial_peaks(select_runs(every[every["trials"] == n], n=n, temperature=1e-3, drive_rate=2e-8,
                                     strengthening=strengthening))
@@ -126,11 +127,11 @@ def estimator_summary(runs, every):
                 mine = slips[slips["interface"] == a]
                 origin, intercept = estimator(mine, T0, "origin"), estimator(mine, T0, "intercept")
                 true = paired_slopes(peaks[peaks["interface"] == a]) if not peaks.empty else (np.nan, np.nan, 0)
-                T = mine["T"].to_numpy(dtype=float)
+                T = mine["T_fe"].to_numpy(dtype=float)
                 T = T[np.isfinite(T)]
                 spread = np.percentile(T / T.mean(), [5, 95]) if T.size else [np.nan, np.nan]
                 interfaces = pd.concat([item.tables["interfaces"] for item in chosen["data"]])
-                R_slow = mean_sem(interfaces.loc[interfaces["a"] == a, "R_slow"])
+                R_slow = mean_sem(interfaces.loc[interfaces["interface"] == a, "R_slow"])
                 print(f"- lambda {strengthening:g}, n = {n}, a = {a}: origin B = {fmt(origin['B'], origin['B_error'])} "
                       f"({origin['slips']} slips, {origin['bins']} bins); intercept B = "
                       f"{fmt(intercept['B'], intercept['B_error'])}, c = {fmt(intercept['c'], intercept['c_error'], 3)}; "
@@ -139,7 +140,7 @@ def estimator_summary(runs, every):
         if pooled:
             spread = spread_of_aging_rate(pd.concat(pooled, ignore_index=True))
             print(f"- lambda {strengthening:g}: std(B_a) / std at n = 1, per (a, n): "
-                  + ", ".join(f"({row.a}, {row.n}) {row.std_normalised:.2f}" for row in spread.itertuples()))
+                  + ", ".join(f"({row.interface}, {row.n}) {row.std_normalised:.2f}" for row in spread.itertuples()))
 
 
 def aftershock_summary(runs, study):

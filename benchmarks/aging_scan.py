@@ -80,7 +80,7 @@ def run_scan(out, seeds):
 def mechanism(slips, a):
     """Rows per n of interface ``a``: observed mean B_a (+- sem over runs), its prediction from one line
     over all n, the per-n offset of a common-slope fit, and the direct effect of the faster loading."""
-    part = slips[(slips["a"] == a) & np.isfinite(slips["T"].to_numpy(dtype=float))]
+    part = slips[(slips["interface"] == a) & np.isfinite(slips["T"].to_numpy(dtype=float))]
     x, y = np.log(part["T"].to_numpy()), part["dmu"].to_numpy()
     line = fit_aging(part["T"], part["dmu"], fit="intercept")
     ns = sorted(part["n"].unique())

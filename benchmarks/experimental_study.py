@@ -54,7 +54,7 @@ def phenomenology(events):
     single = slips[~slips["multi"].astype(bool)]
     stack = single[single["protocol"] == "stack"]
     print("\nP(T_a), a = 1 (stack), single slips:  n  count  mean  median  q10  q90 [s]  peaks of P(log10 T)")
-    for n, part in stack[stack["a"] == 1].groupby("n"):
+    for n, part in stack[stack["interface"] == 1].groupby("n"):
         T = part["T"].dropna().to_numpy()
         counts, edges = np.histogram(np.log10(T), bins=np.arange(0.5, 3.3, 0.1))
         peaks = [f"{10 ** (0.5 * (edges[k] + edges[k + 1])):.0f}" for k in range(1, len(counts) - 1)
@@ -62,18 +62,18 @@ def phenomenology(events):
         print(f"  {n}  {T.size:5d}  {T.mean():6.1f}  {np.median(T):6.1f}  {np.quantile(T, 0.1):6.1f}  "
               f"{np.quantile(T, 0.9):6.1f}   {', '.join(peaks)}")
     print("\nstd(dmu_a) per n (stack; columns a = 1..4); individual protocol in the last row")
-    table = stack.groupby(["n", "a"])["dmu"].std().unstack()
+    table = stack.groupby(["n", "interface"])["dmu"].std().unstack()
     print(table.loc[:, [a for a in (1, 2, 3, 4) if a in table.columns]].round(4).to_string())
     alone = single[single["protocol"] == "individual"]
-    print("individual", alone.groupby("a")["dmu"].std().round(4).to_dict(),
-          "mean dmu", alone.groupby("a")["dmu"].mean().round(3).to_dict())
+    print("individual", alone.groupby("interface")["dmu"].std().round(4).to_dict(),
+          "mean dmu", alone.groupby("interface")["dmu"].mean().round(3).to_dict())
     print("\nstd(B_a) / std(B_a)_{n=1}")
     spread = spread_of_aging_rate(slips)
-    print(spread.pivot(index="n", columns="a", values="std_normalised").round(2).to_string())
+    print(spread.pivot(index="n", columns="interface", values="std_normalised").round(2).to_string())
     interfaces = load_interfaces(events)
     driven = interfaces[(interfaces["protocol"] == "stack") & interfaces["driven"].astype(bool)]
     print("\nR_slow (mean over runs)")
-    print(driven.groupby(["n", "a"])["R_slow"].mean().unstack().round(3).to_string())
+    print(driven.groupby(["n", "interface"])["R_slow"].mean().unstack().round(3).to_string())
     fit = fit_aging(stack["T"], stack["dmu"])
     print(f"\naging fit on {fit.n_slips} stack slips: B = {fit.B:.4f} +- {fit.B_error:.4f}")
     print(f"multi-interface slips: {int(slips['multi'].sum())} of {len(slips)}")

@@ -155,7 +155,7 @@ def _slip_sample(label, params, args):
         classified["steady"] = classified["increment"].to_numpy() >= args.start
     slips = steady_slips(classified, N)
     counts = np.array([(slips["s"] == s).sum() for s in range(1, n + 1)])
-    drops = slip_interfaces(classified, N)["dmu"].to_numpy()
+    drops = slip_interfaces(classified, N)["dmu_sig0"].to_numpy()
     events = classified["kick"].to_numpy() & classified["steady"].to_numpy(dtype=bool)
     sizes = classified.loc[events, [f"S_a{a}" for a in range(1, n + 1)]].sum(axis=1).to_numpy()
     if not events.any():

@@ -63,7 +63,7 @@ def main(trees):
         n = key[3]
         slips = pd.concat([f.tables["slips"] for f in files], ignore_index=True)
         per = pd.concat([f.tables["slip_interfaces"] for f in files], ignore_index=True)
-        dgamma = per.loc[per["a"] == 1, "dgamma"].dropna().to_numpy(dtype=float)
+        dgamma = per.loc[per["interface"] == 1, "dgamma"].dropna().to_numpy(dtype=float)
         sequences = sequence_fractions(pd.concat([f.tables["sequences"] for f in files], ignore_index=True))
         row = summary.loc[key]
         rho = ", ".join(f"{value:.2f}" for value in slip_fractions(slips, n))

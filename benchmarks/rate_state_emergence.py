@@ -108,10 +108,10 @@ def main(study):
         print(f"  a={a}: " + "  ".join(cells))
     print("\nstd(B_a) +- err per a and n, and normalised by its n = 1 value +- jackknife error over the seeds "
           "(spread_of_aging_rate)")
-    spread = spread_of_aging_rate(slips)
+    spread = spread_of_aging_rate(slips.rename(columns={"a": "interface"}))
     for a, part in table.groupby("a"):
         errors = {n: std_error(g["B_a"]) for n, g in part.groupby("n")}
-        rows = spread[spread["a"] == a]
+        rows = spread[spread["interface"] == a]
         cells = [f"n={r.n}: {r.std:.4f}+-{errors.get(r.n, np.nan):.4f} ({r.std_normalised:.2f}"
                  f"+-{r.std_normalised_error:.2f}x, N={r.count})" for r in rows.itertuples()]
         print(f"  a={a}: " + "  ".join(cells))
@@ -127,10 +127,10 @@ def main(study):
 
     paths = sorted((Path(study) / "events" / "experiment-events").glob("*/*.h5"))
     interfaces = load_interfaces(paths, shuffled=True)
-    driven = interfaces[(interfaces["protocol"] == "stack") & (interfaces["a"] <= interfaces["n"])]
+    driven = interfaces[(interfaces["protocol"] == "stack") & (interfaces["interface"] <= interfaces["n"])]
     print("\nR_slow = 1 - sum(dR)/R_tot, stack, mean +- sem over seeds, per a (rows) and n (columns); 'shuffled':"
           " n = 5 with the slabs shuffled (a is the position)")
-    for a, part in driven.groupby("a"):
+    for a, part in driven.groupby("interface"):
         cells = [f"n={n}: {g['R_slow'].mean():.3f}+-{sem(g['R_slow']):.3f}" for n, g in
                  part[~part["shuffled"]].groupby("n")]
         moved = part[part["shuffled"]]

@@ -61,8 +61,9 @@ def runs_summary(runs, study):
               f"({int(slips['multi'].sum())} in multi-slips)")
         for a, part in slips[~slips["multi"].to_numpy(dtype=bool)].groupby("interface"):
             sem = np.sqrt(len(part))
-            print(f"    a = {a}: {len(part)} single slips, drop {part['dmu'].mean():.4f} ± {part['dmu'].std() / sem:.4f}, "
-                  f"peak {part['mu_before'].mean():.4f} ± {part['mu_before'].std() / sem:.4f}")
+            print(f"    a = {a}: {len(part)} single slips, drop {part['dmu_sig0'].mean():.4f} ± "
+                  f"{part['dmu_sig0'].std() / sem:.4f}, peak {part['mu_before_sig0'].mean():.4f} ± "
+                  f"{part['mu_before_sig0'].std() / sem:.4f}")
 
 
 def stacks(runs, params, events):
@@ -70,12 +71,14 @@ def stacks(runs, params, events):
     spread = []
     for _, run in runs[figs_thermal._at_rate(runs, params)].sort_values("n").iterrows():
         slips = run["data"].tables["slip_events"]
-        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
-        print(f"n = {run['n']}, pooled: {fits(slips['T'].to_numpy(), slips['dmu'].to_numpy(), run['T0'])}")
+        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T_fe"].to_numpy(dtype=float))]
+        print(f"n = {run['n']}, pooled: {fits(slips['T_fe'].to_numpy(), slips['dmu_sig0'].to_numpy(), run['T0'])}")
         for a, part in slips.groupby("interface"):
-            print(f"    a = {a}: {len(part)} slips, T median {part['T'].median():.3g}, B_a {part['B_a'].mean():.5f} "
-                  f"(std {part['B_a'].std():.5f}); {fits(part['T'].to_numpy(), part['dmu'].to_numpy(), run['T0'])}")
-            spread.append(pd.DataFrame({"a": a, "n": run["n"], "protocol": "stack", "B_a": part["B_a"].to_numpy()}))
+            print(f"    a = {a}: {len(part)} slips, T median {part['T_fe'].median():.3g}, B_a "
+                  f"{part['B_a_sig0'].mean():.5f} (std {part['B_a_sig0'].std():.5f}); "
+                  f"{fits(part['T_fe'].to_numpy(), part['dmu_sig0'].to_numpy(), run['T0'])}")
+            spread.append(pd.DataFrame({"interface": a, "n": run["n"], "protocol": "stack",
+                                        "B_a": part["B_a_sig0"].to_numpy()}))
     if spread:
         print(spread_of_aging_rate(pd.concat(spread)).to_string(index=False))
     if not events:
@@ -86,28 +89,28 @@ def stacks(runs, params, events):
                   & np.isfinite(slips["T"].to_numpy(dtype=float))]
     for n, part in slips.groupby("n"):
         print(f"n = {n}, pooled: {fits(part['T'].to_numpy(), part['dmu'].to_numpy(), 1.0)}")
-        for a, mine in part.groupby("a"):
+        for a, mine in part.groupby("interface"):
             print(f"    a = {a}: {len(mine)} slips, T median {mine['T'].median():.3g} s, B_a {mine['B_a'].mean():.4f} "
                   f"(std {mine['B_a'].std():.4f})")
-    print(spread_of_aging_rate(slips[["a", "n", "protocol", "B_a", "seed"]]).to_string(index=False))
+    print(spread_of_aging_rate(slips[["interface", "n", "protocol", "B_a", "seed"]]).to_string(index=False))
     interfaces = load_interfaces(events)
     interfaces = interfaces[(interfaces["protocol"] == "stack") & (interfaces["n"] <= 3) & interfaces["driven"]]
     print("R_slow (mean, sem over seeds):")
-    print(interfaces.groupby(["n", "a"])["R_slow"].agg(["mean", "sem", "size"]).to_string())
+    print(interfaces.groupby(["n", "interface"])["R_slow"].agg(["mean", "sem", "size"]).to_string())
 
 
 def cycles(runs):
     """The runs with hold cycles: Delta mu against the waiting time (aging fits), and per hold time."""
     for _, run in runs[runs["thermal"] & runs["holds"]].iterrows():
         slips = run["data"].tables["slip_events"]
-        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
-        T = slips["T"].to_numpy()
+        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T_fe"].to_numpy(dtype=float))]
+        T = slips["T_fe"].to_numpy()
         print(f"== hold cycles, {Path(run['file']).stem}: {len(slips)} single slips with a T, nu T from "
               f"{T.min() / run['T0']:.3g} to {T.max() / run['T0']:.3g}")
-        print(f"    {fits(T, slips['dmu'].to_numpy(), run['T0'])}")
+        print(f"    {fits(T, slips['dmu_sig0'].to_numpy(), run['T0'])}")
         held = slips.assign(hold=np.where(slips["hold"] > 0, slips["hold"], 0.0).round(-3))
-        print(held.groupby("hold").agg(slips=("dmu", "size"), dmu=("dmu", "mean"), dmu_std=("dmu", "std"),
-                                       peak=("mu_before", "mean")).to_string())
+        print(held.groupby("hold").agg(slips=("dmu_sig0", "size"), dmu=("dmu_sig0", "mean"),
+                                       dmu_std=("dmu_sig0", "std"), peak=("mu_before_sig0", "mean")).to_string())
 
 
 def comparisons(runs, params, events):
@@ -133,7 +136,7 @@ def holds(runs):
             continue
         table = figs_thermal.hold_differences(trials)
         slope, error, _ = figs_thermal.hold_slope(table)
-        interface = tables["interfaces"].set_index("a").loc[1]
+        interface = tables["interfaces"].set_index("interface").loc[1]
         slip = interface["dR_sum"] / interface["n_slips"]
         times = np.geomspace(1.0 * run["T0"], trials["hold_time"].max(), 60)
         rate, rate_error, _ = figs_thermal.creep_rate(trials, tables["creep"], times)

@@ -19,6 +19,7 @@ import pandas as pd
 from . import formats, registry
 from .params import ParameterError, describe
 from .runs import open_run
+from .vocabulary import with_units
 
 __all__ = ["simulate", "open_run", "study", "plugins", "params"]
 
@@ -73,33 +74,39 @@ def simulate(solver, output, *, threads=1, overwrite=False, **params):
     return open_run(output)
 
 
-def study(name_or_path="default"):
+def study(name_or_path="default", *, workdir=None):
     """Open a study's results: its database, its results tree and its config.
 
     Parameters
     ----------
     name_or_path : str or os.PathLike, optional
-        A study name (``"default"``, ``"ci"``, ...: ``results/{name}`` in the working directory, as
+        A study name (``"default"``, ``"ci"``, ...: ``results/{name}`` in the workflow directory, as
         ``snakemake`` writes it when run there), a config file (``workflow/config/ci.yaml``), or a
         results tree (``results/ci``, an absolute path).
+    workdir : str or os.PathLike, optional
+        The workflow directory (where Snakemake ran). Default: ``$STICKSLIP_WORKDIR``, else the nearest
+        folder at or above the current one with a ``Snakefile``, so that a notebook in a subfolder of the
+        repository finds its studies (:mod:`stickslip.workdir`).
 
     Returns
     -------
     stickslip.results.StudyResults
-        ``runs(...)``, ``events(...)``, ``figures()``, ``sql(...)`` (pandas DataFrames from read-only
-        connections, :mod:`stickslip.provenance.query`), ``open_run(run_id)``, ``root``, ``database``,
-        ``config``.
+        ``runs(...)``, ``events(...)`` with keyword filters on every parameter (``plates=3, k_drive=...,
+        regime="stiff"``), ``figures()``, ``sql(...)`` (typed pandas DataFrames with ``attrs["units"]``, from
+        read-only connections, :mod:`stickslip.provenance.query`), ``open_run(run_id)``, ``open_runs(frame)``,
+        ``find(**filters)`` (the simulations opened one at a time), ``root``, ``database``, ``config``.
 
     Raises
     ------
-    stickslip.h5io.FileFormatError
-        If the study has neither results nor a config there.
+    stickslip.errors.StudyNotFoundError
+        A ``FileNotFoundError`` (and a ``FileFormatError``): the study has neither results nor a config
+        there; the message says where it looked.
     """
     # Imported here: the database layer (SQLAlchemy and the schema) takes 0.24 s to import, which every command
     # and workflow job would pay, since each imports this package (python -X importtime, 2026-11-26).
     from .results import StudyResults
 
-    return StudyResults(name_or_path)
+    return StudyResults(name_or_path, workdir=workdir)
 
 
 def plugins(kind=None):
@@ -115,8 +122,8 @@ def plugins(kind=None):
     pandas.DataFrame
         Plugins: one row each, columns ``kind``, ``name``, ``version``, ``summary``, ``consumes``,
         ``produces``, ``inputs`` (a figure's input categories), ``replay`` (a solver that replays
-        events), ``module``. Formats: ``name``, ``version``, ``module``, ``summary``, ``source``,
-        ``describe``, ``unstamped`` (:class:`stickslip.formats.Format`).
+        events), ``module``. Formats: ``name``, ``version`` (text, as a plugin's), ``module``, ``summary``,
+        ``source``, ``describe``, ``unstamped`` (:class:`stickslip.formats.Format`). ``attrs["units"]``.
 
     Raises
     ------
@@ -128,13 +135,15 @@ def plugins(kind=None):
                              f"{', '.join(map(repr, LISTED))}")
     if kind == "format":
         registry.available("solver")  # loads every plugin, and with them the formats they register
-        return pd.DataFrame([dataclasses.asdict(fmt) for fmt in formats.available_formats().values()])
+        table = pd.DataFrame([dataclasses.asdict(fmt) for fmt in formats.available_formats().values()])
+        return with_units(table.astype({"version": str, "unstamped": "Int64"}))
     rows = [{"kind": plugin.kind, "name": plugin.name, "version": plugin.version, "summary": plugin.summary,
              "consumes": plugin.consumes, "produces": plugin.produces, "inputs": plugin.inputs,
              "replay": plugin.replay is not None, "module": plugin.module}
             for each in (registry.KINDS if kind is None else (kind,))
             for plugin in registry.available(each).values()]
-    return pd.DataFrame(rows)
+    return with_units(pd.DataFrame(rows, columns=["kind", "name", "version", "summary", "consumes", "produces",
+                                                  "inputs", "replay", "module"]))
 
 
 def params(name, kind="solver"):
@@ -150,7 +159,8 @@ def params(name, kind="solver"):
     -------
     pandas.DataFrame
         Indexed by parameter name, in declaration order: ``type``, ``default``, ``unit`` and ``doc``
-        (:func:`stickslip.params.describe`).
+        (:func:`stickslip.params.describe`); ``attrs["units"]`` (of these columns: none; the parameters' own
+        units are the column ``unit``).
 
     Raises
     ------
@@ -159,4 +169,5 @@ def params(name, kind="solver"):
     """
     rows = describe(registry.get(kind, name).params)
     # dtype object: every default stays the value it is (an int among floats is not made a float)
-    return pd.DataFrame(rows, columns=["name", "type", "default", "unit", "doc"], dtype=object).set_index("name")
+    table = pd.DataFrame(rows, columns=["name", "type", "default", "unit", "doc"], dtype=object).set_index("name")
+    return with_units(table.astype({"type": str, "unit": str, "doc": str}))

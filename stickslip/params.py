@@ -36,6 +36,7 @@ __all__ = [
     "ParameterWarning",
     "param",
     "parse_params",
+    "parse_value",
     "did_you_mean",
     "parse_assignments",
     "params_to_dict",
@@ -217,6 +218,37 @@ def parse_params(cls, values=None, *, owner=""):
     if check is not None:
         check()
     return instance
+
+
+def parse_value(cls, name, value, *, owner=""):
+    """One parameter's value converted and checked as :func:`parse_params` checks it (without ``check()``).
+
+    Parameters
+    ----------
+    cls : type
+        A parameter dataclass.
+    name : str
+        One of its fields.
+    value : object
+        The value (a string is converted to the field's type).
+    owner : str, optional
+        The plugin, for messages.
+
+    Returns
+    -------
+    object
+
+    Raises
+    ------
+    ParameterError
+        If ``cls`` has no such field, or the value does not fit it.
+    """
+    types = _field_types(cls)
+    if name not in types:
+        where = f" of {owner}" if owner else ""
+        raise ParameterError(f"unknown parameter {name!r}{where}{did_you_mean(name, types)}")
+    field = next(f for f in dataclasses.fields(cls) if f.name == name)
+    return _convert(name, value, types[name], field.metadata)
 
 
 def parse_assignments(assignments):

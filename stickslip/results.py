@@ -1,25 +1,31 @@
 """A study's results opened for reading: its results tree, its database and its config.
 
-A study (a workflow config) writes everything under ``results/{study}/`` in the directory where
+A study (a workflow config) writes everything under ``results/{study}/`` in the workflow directory, where
 Snakemake ran (:mod:`stickslip.study`), its database at ``results/{study}/stickslip.sqlite``.
-:class:`StudyResults` finds them from a study's name, its config file or its results tree, and
-queries the database with the functions of :mod:`stickslip.provenance.query` (read-only
-connections), which ``stickslip db`` runs too.
+:class:`StudyResults` finds that directory from any folder below it (:mod:`stickslip.workdir`), finds the
+study there from its name, its config file or its results tree, and queries the database with the functions
+of :mod:`stickslip.provenance.query` (read-only connections), which ``stickslip db`` runs too. Its tables are
+typed and carry their units (:mod:`stickslip.vocabulary`); its filters are those of ``stickslip db``
+(:mod:`stickslip.provenance.filters`).
 """
 
+import dataclasses
 import re
 from pathlib import Path
 
 import yaml
 
+from .errors import RunNotFoundError, StudyNotFoundError
 from .h5io import FileFormatError
 from .provenance import query
+from .provenance.filters import EVENT_FILTERS, RUN_FILTERS, with_filters
 from .runs import open_run
 from .study import PATHS, RESULTS, study_name
+from .workdir import ENVIRONMENT, find_workdir
 
 __all__ = ["StudyResults", "CONFIGS"]
 
-#: Where the shipped study configs are, relative to the working directory (the repository's root).
+#: Where the shipped study configs are, relative to the workflow directory (the repository's root).
 CONFIGS = "workflow/config"
 
 _RUN_ID = re.compile(r"^[0-9a-f]{16}$")
@@ -36,44 +42,74 @@ def _read_config(path):
     return config
 
 
+def _plugin_units(frame):
+    """Units of the ``params.<name>`` columns of a runs table: the units its plugins declare."""
+    from . import registry
+
+    units = {}
+    for kind, plugin in frame[["kind", "plugin"]].drop_duplicates().itertuples(index=False):
+        try:
+            declared = registry.get(kind, plugin).params
+        except (registry.PluginError, KeyError):
+            continue  # a plugin that is not installed (or a mesh job): its parameters have no known unit
+        for field in dataclasses.fields(declared):
+            column = f"params.{field.name}"
+            if column in frame.columns:
+                unit = field.metadata.get("unit", "")
+                units[column] = unit if units.get(column, unit) == unit else None  # plugins disagree: no one unit
+    return units
+
+
 class StudyResults:
     """One study's results: the results tree, the database, the config (see :func:`stickslip.study`).
 
     Parameters
     ----------
     name_or_path : str or os.PathLike
-        A study name (its results tree is ``results/{name}`` in the working directory, as for
+        A study name (its results tree is ``results/{name}`` in the workflow directory, as for
         ``snakemake`` and ``stickslip db --study``), a config file (``*.yaml``: the study it names,
-        whose tree is under ``results/`` in the working directory), or a study's results tree (a
-        path with a directory separator, e.g. ``results/ci`` or an absolute path).
+        whose tree is under ``results/`` in the workflow directory), or a study's results tree (a
+        path with a directory separator, e.g. ``results/ci`` or an absolute path). Relative files are
+        looked for in the current folder, then in the workflow directory.
+    workdir : str or os.PathLike, optional
+        The workflow directory; default: ``$STICKSLIP_WORKDIR``, else the nearest folder at or above the
+        current one with a ``Snakefile`` (:func:`stickslip.workdir.find_workdir`).
 
     Attributes
     ----------
     name : str
+    workdir : stickslip.workdir.Workdir
+        The workflow directory and how it was found.
     root : pathlib.Path
         The results tree: ``sim/``, ``events/``, ``mesh/``, ``figures/``, ``logs/`` (:data:`stickslip.study.PATHS`).
     database : pathlib.Path
         ``root / "stickslip.sqlite"``.
     config_file : pathlib.Path or None
-        The config given, else ``workflow/config/{name}.yaml`` beside the results tree if it exists and
+        The config given, else ``workflow/config/{name}.yaml`` in the workflow directory if it exists and
         names this study, else None.
     config : dict or None
         Its content as written (the plugins' defaults are not filled in).
 
     Raises
     ------
+    stickslip.errors.StudyNotFoundError
+        A ``FileNotFoundError`` (and a ``FileFormatError``): there is neither a results tree nor a config of
+        that study; the message says where it looked and how the workflow directory was found.
     stickslip.h5io.FileFormatError
-        If there is neither a results tree nor a config of that study, or the config is not readable.
+        If the config is not readable.
     """
 
-    def __init__(self, name_or_path="default"):
+    def __init__(self, name_or_path="default", *, workdir=None):
+        self.workdir = find_workdir(workdir)
         given = Path(name_or_path)
         if given.suffix in (".yaml", ".yml"):
-            self.config_file, self.config = given, _read_config(given)
-            self.name = study_name(self.config, [given])
-            self.root = Path(RESULTS) / self.name
+            path = self._existing(given)
+            self.config_file, self.config = path, _read_config(path)
+            self.name = study_name(self.config, [path])
+            self.root = self.workdir.path / RESULTS / self.name
         else:
-            self.root = given if (given.is_absolute() or len(given.parts) > 1) else Path(RESULTS) / given
+            self.root = (self._existing(given) if given.is_absolute() or len(given.parts) > 1
+                         else self.workdir.path / RESULTS / given)
             self.name = self.root.name
             candidate = self.root.parent.parent / CONFIGS / f"{self.name}.yaml"
             self.config_file, self.config = None, None
@@ -82,39 +118,70 @@ class StudyResults:
                 if study_name(config, [candidate]) == self.name:
                     self.config_file, self.config = candidate, config
         if self.config is None and not self.root.is_dir():
-            raise FileFormatError(f"{self.root}: no results of study {self.name!r} (run `snakemake --cores 2` with its "
-                                  f"config), and no config {CONFIGS}/{self.name}.yaml")
+            raise StudyNotFoundError(
+                f"{self.root}: no results of study {self.name!r} (run `snakemake --cores 2` with its config there) "
+                f"and no config {CONFIGS}/{self.name}.yaml; the workflow directory is {self.workdir} (another: "
+                f"workdir= or ${ENVIRONMENT})")
         self.database = self.root / PATHS["database"]
+
+    def _existing(self, given):
+        """A relative path as given if it exists from the current folder, else in the workflow directory."""
+        if given.is_absolute() or given.exists():
+            return given
+        return self.workdir.path / given
 
     def __repr__(self):
         return f"<StudyResults {self.name!r}: {self.root}, config {self.config_file}>"
 
+    @with_filters(RUN_FILTERS)
     def runs(self, **filters):
         """The study's runs with their parameters (:func:`stickslip.provenance.query.runs`; ``stickslip db runs``).
 
         Parameters
         ----------
-        **filters
-            ``kind``, ``plugin``, ``solver``, ``n``, ``regime``, ``seed``.
+        {filters}
+        **parameters
+            Any parameter of a plugin, e.g. ``backend="cpu"`` (:func:`stickslip.params`).
 
         Returns
         -------
         pandas.DataFrame
-        """
-        return query.runs(self.database, **filters)
+            One row per run (solver, analysis, figure, mesh): typed columns, the simulation's parameters
+            (``solver``, ``n``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``regime``, ...; missing for
+            other runs), ``started_at`` and ``finished_at`` as UTC datetimes, and ``params.<name>``, one column
+            per plugin parameter; ``attrs["units"]`` maps every column to its unit.
 
+        Raises
+        ------
+        stickslip.params.ParameterError
+            A ``ValueError`` naming a filter that does not exist or a value that does not fit it.
+        """
+        frame = query.runs(self.database, **filters)
+        frame.attrs["units"].update(_plugin_units(frame))
+        return frame
+
+    @with_filters(EVENT_FILTERS)
     def events(self, **filters):
         """Slip events with their simulation's parameters (:func:`stickslip.provenance.query.events`; ``db events``).
 
         Parameters
         ----------
-        **filters
-            ``solver``, ``analysis``, ``source`` ("numerical" or "experimental": their ``dmu`` are in other
-            units), ``n``, ``interface``, ``regime``, ``seed``, ``run_id``.
+        {filters}
+        **parameters
+            Any parameter of the simulation's or the analysis's plugin (:func:`stickslip.params`).
 
         Returns
         -------
         pandas.DataFrame
+            One row per (event, slipping interface): ``interface``, ``multi`` (bool), ``dmu`` [1] (lab and
+            virtual slips) or ``dmu_sig0`` [sig0] (the model's), ``slip`` [mm], ``time`` [s] or ``t`` [time], the
+            analysis's further columns (``T``, ``dF``, ``B_a``, ``dgamma``, ...) and the simulation's parameters;
+            ``attrs["units"]``.
+
+        Raises
+        ------
+        stickslip.params.ParameterError
+            A ``ValueError`` naming a filter that does not exist or a value that does not fit it.
         """
         return query.events(self.database, **filters)
 
@@ -130,6 +197,7 @@ class StudyResults:
         Returns
         -------
         pandas.DataFrame
+            Columns named as the vocabulary's are typed and have their units in ``attrs["units"]``.
         """
         return query.sql(statement, self.database)
 
@@ -148,12 +216,58 @@ class StudyResults:
         Raises
         ------
         ValueError
-            If ``run_id`` is not a run id, or the database holds no simulation of that id.
+            If ``run_id`` is not a run id.
+        stickslip.errors.RunNotFoundError
+            A ``LookupError`` (and a ``ValueError``): the database holds no simulation of that id.
         """
         if not isinstance(run_id, str) or not _RUN_ID.match(run_id):
             raise ValueError(f"run_id: expected 16 hexadecimal characters, got {run_id!r}")
         found = self.sql(f"SELECT path FROM simulations WHERE run_id = '{run_id}'")
         if found.empty:
-            raise ValueError(f"run_id: {self.database} holds no simulation {run_id}")
+            raise RunNotFoundError(f"run_id: {self.database} holds no simulation {run_id}")
         path = Path(found["path"].iloc[0])
         return open_run(path if path.is_absolute() else self.root.parent.parent / path)
+
+    def open_runs(self, frame):
+        """Open the simulations of a table's ``run_id`` column, one at a time (a generator).
+
+        Parameters
+        ----------
+        frame : pandas.DataFrame or Iterable[str]
+            A table with a column ``run_id`` (e.g. ``study.runs(kind="solver", n=3)``) or ``simulation_run_id``
+            (``study.events(...)``: each simulation once), or run ids.
+
+        Yields
+        ------
+        stickslip.runs.FemRun or stickslip.runs.TimeseriesRun
+            In the table's order; each is closed when the next is opened (``with`` is not needed).
+
+        Raises
+        ------
+        stickslip.errors.RunNotFoundError
+            For a run id that is not a simulation of the study (e.g. an analysis's).
+        """
+        columns = getattr(frame, "columns", ())
+        ids = frame["run_id"] if "run_id" in columns else frame["simulation_run_id"] if \
+            "simulation_run_id" in columns else frame
+        for run_id in dict.fromkeys(ids):
+            with self.open_run(run_id) as run:
+                yield run
+
+    @with_filters(RUN_FILTERS[2:])
+    def find(self, **filters):
+        """The simulations that match the filters, opened one at a time: ``for run in study.find(n=3): ...``.
+
+        :meth:`open_runs` of ``runs(kind="solver", **filters)``.
+
+        Parameters
+        ----------
+        {filters}
+        **parameters
+            Any parameter of a solver (``backend="cpu"``).
+
+        Yields
+        ------
+        stickslip.runs.FemRun or stickslip.runs.TimeseriesRun
+        """
+        yield from self.open_runs(self.runs(kind="solver", **filters))

@@ -8,6 +8,11 @@ workflow runs on that format (``numerical-events``, ``experiment-events``), comp
 functions, so they equal what the workflow writes. Files are opened only for reading, and every
 reader checks the format and its version (a file of another one raises
 :class:`stickslip.h5io.FileFormatError` naming it).
+
+Every table is named in the package's vocabulary and carries its units in ``attrs["units"]``
+(:mod:`stickslip.vocabulary`; the run file's own column names are kept for ``increments``). A run is a context
+manager (``with stickslip.open_run(path) as run:``): it holds no file open between calls, and leaving the block
+(or :meth:`close`) frees what it read and built (tables, mesh, the replay's model).
 """
 
 import dataclasses
@@ -23,11 +28,29 @@ from .experiment.analysis import NAME as EXPERIMENT_EVENTS
 from .experiment.analysis import ExperimentEventsParams, analyse_record, experimental_slip_events
 from .experiment.timeseries import read_timeseries, read_truth
 from .formats.fem_run import RunFile, read_increments, read_run_attrs
+from .errors import IncrementError
 from .h5io import FileFormatError, open_file
 from .output_safety.overwrite import root_attributes
 from .params import parse_params
+from .vocabulary import with_units
 
 __all__ = ["open_run", "FemRun", "RunState", "TimeseriesRun", "READERS"]
+
+
+class _Run:
+    """What every run shares: a context manager that frees what the run read (the file is open only per call)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.close()
+        return False
+
+    def close(self):
+        """Free the tables, mesh and models read or built so far; the run reads them again if used."""
+        for name in self._cached:
+            self.__dict__.pop(name, None)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -66,7 +89,7 @@ class RunState:
     well: np.ndarray
 
 
-class FemRun:
+class FemRun(_Run):
     """A ``fem-run`` file (the finite-element model, :mod:`stickslip.formats.fem_run`), read only.
 
     Parameters
@@ -100,6 +123,7 @@ class FemRun:
     """
 
     format = "fem-run"
+    _cached = ("increments", "mesh", "_replay")
 
     def __init__(self, path):
         self.path = Path(path)
@@ -107,10 +131,17 @@ class FemRun:
         self.params = self.header["params"]
         self.solver = str(self.header["solver"])
 
-    def __repr__(self):
+    def __repr__(self):  # the file's name, as h5py's File shows it (the whole path: .path)
         h = self.header
-        return (f"<FemRun {self.path}: {self.solver} N={h['N']} plates={h['plates']} phi={h['phi']:.3g} "
+        return (f"<FemRun {self.path.name}: {self.solver} blocks={h['N']} plates={h['plates']} phi={h['phi']:.3g} "
                 f"({h['regime']}), {h['nstored']} increments{', completed' if h['completed'] else ''}>")
+
+    def _stored(self, increment):
+        """``increment`` as an int, or IncrementError if the file does not store it."""
+        stored = int(self.header["nstored"])
+        if not 0 <= int(increment) < stored:
+            raise IncrementError(f"{self.path}: increment {increment} is not stored (0 ... {stored - 1})")
+        return int(increment)
 
     @functools.cached_property
     def increments(self):
@@ -123,9 +154,9 @@ class FemRun:
         the interfaces) ``epsd_<l>`` [eps0], ``sigd_<l>`` [sig0], ``ubar_<l>`` (mean x-displacement
         [FE length]), ``fxdrive_<l>`` (spring elongation [FE length]), per interface ``a`` ``S_a<a>``
         (net well hops since the previous increment) and ``A_a<a>`` (blocks that changed well); a free
-        lever adds ``lever_target``, ``lever_position`` [FE length].
+        lever adds ``lever_target``, ``lever_position`` [FE length]. ``attrs["units"]`` gives every column's unit.
         """
-        return read_increments(self.path)
+        return with_units(read_increments(self.path))
 
     @functools.cached_property
     def mesh(self):
@@ -152,9 +183,12 @@ class FemRun:
 
         Raises
         ------
+        stickslip.errors.IncrementError
+            An ``IndexError`` (and a ``FileFormatError``): the increment is not stored.
         stickslip.h5io.FileFormatError
-            If the increment is not stored, or the solver that wrote the file cannot replay it.
+            If the solver that wrote the file cannot replay it.
         """
+        increment = self._stored(increment)
         with open_file(self.path) as file:
             u, target, lever_target, t = RunFile(file).state(increment)
         fields = self._replay.interface_state(increment)
@@ -169,16 +203,17 @@ class FemRun:
         dict[str, pandas.DataFrame]
             ``increments`` (classified: ``steady``, ``kind`` single/multi/micro/load, ...), ``slips`` (one row
             per steady-state slip event: ``increment``, ``gamma`` [gamma0], ``s`` slipping interfaces,
-            ``interfaces``, ``single``, ``sigma_before``, ``sigma_after``, ``dsigma`` [sig0]),
-            ``slip_interfaces`` (one row per slip and slipping interface ``a``: ``dmu`` [sig0], ...),
+            ``interfaces``, ``multi``, ``sigma_before``, ``sigma_after``, ``dsigma`` [sig0]),
+            ``slip_interfaces`` (one row per slip and slipping ``interface``: ``dmu_sig0`` [sig0], ...),
             ``sequences``, ``slip_events`` (:meth:`slip_events`) and ``periodicity``
-            (:func:`stickslip.events.plugin.event_tables`).
+            (:func:`stickslip.events.plugin.event_tables`); each with ``attrs["units"]``.
 
         Notes
         -----
         Cost: one pass over the increment table, computed at each call.
         """
-        return event_tables(self.increments, int(self.header["N"]), source=str(self.path))
+        tables = event_tables(self.increments, int(self.header["N"]), source=str(self.path))
+        return {name: with_units(table) for name, table in tables.items()}
 
     def slip_events(self):
         """The run's slips as the results database holds them (the ``slip_events`` table of :meth:`events`).
@@ -187,8 +222,8 @@ class FemRun:
         -------
         pandas.DataFrame
             One row per (steady-state slip event, slipping interface): ``event``, ``interface`` (a, 1 =
-            lowest), ``multi`` (more than one interface slipped), ``dmu`` (stress drop of the interface
-            [sig0]), ``increment``, ``dgamma`` [gamma0].
+            lowest), ``multi`` (more than one interface slipped), ``dmu_sig0`` (stress drop of the interface
+            [sig0]), ``increment``, ``dgamma`` [gamma0]; ``attrs["units"]``.
         """
         return self.events()["slip_events"]
 
@@ -206,18 +241,21 @@ class FemRun:
         Returns
         -------
         pandas.DataFrame
-            ``a`` (interface, 1 = lowest), ``block`` (0 ... N-1), ``t`` (time since the kick [FE time]),
-            ``direction`` (+1 / -1): one row per well hop.
+            ``interface`` (a, 1 = lowest), ``block`` (0 ... N-1), ``t`` (time since the kick [FE time]),
+            ``hop_direction`` (+1 / -1): one row per well hop; ``attrs["units"]``.
 
         Raises
         ------
+        stickslip.errors.IncrementError
+            An ``IndexError`` (and a ``FileFormatError``): the increment is not stored.
         stickslip.h5io.FileFormatError
-            If the increment is not a stored kick, or the solver cannot replay events.
+            If the increment is not a kick, or the solver cannot replay events.
         """
-        return self._replay.failures(int(increment))
+        failures = self._replay.failures(self._stored(increment))
+        return with_units(failures.rename(columns={"a": "interface", "direction": "hop_direction"}))
 
 
-class TimeseriesRun:
+class TimeseriesRun(_Run):
     """A ``timeseries`` file (a virtual experiment or a lab recording, :mod:`stickslip.experiment.timeseries`), read only.
 
     Parameters
@@ -246,6 +284,7 @@ class TimeseriesRun:
     """
 
     format = "timeseries"
+    _cached = ()
 
     def __init__(self, path):
         self.path = Path(path)
@@ -258,7 +297,7 @@ class TimeseriesRun:
 
     def __repr__(self):
         r = self.record
-        return (f"<TimeseriesRun {self.path}: {self.solver or 'lab recording'} {r.protocol} n={r.n} "
+        return (f"<TimeseriesRun {self.path.name}: {self.solver or 'lab recording'} {r.protocol} n={r.n} "
                 f"{r.t_x[-1] - r.t_x[0]:.0f} s>")
 
     def events(self, **analysis_params):
@@ -273,10 +312,10 @@ class TimeseriesRun:
         Returns
         -------
         dict[str, pandas.DataFrame]
-            ``slips`` (one row per slip of one interface: ``t`` [s], ``a``, ``multi``, ``dF`` [N], ``dmu``,
-            ``T`` [s], ``dR`` [mm], ``B_a``, ...: :func:`stickslip.experiment.analysis.analyse_record`, the
-            CSV of ``analyze-experiment``), ``interfaces`` (``R_tot``, ``dR_sum`` [mm], ``R_slow``, ...) and
-            ``slip_events`` (:meth:`slip_events`).
+            ``slips`` (one row per slip of one interface: ``time`` [s], ``interface``, ``multi``, ``dF`` [N],
+            ``dmu``, ``T`` [s], ``slip`` [mm], ``B_a``, ...: :func:`stickslip.experiment.analysis.analyse_record`,
+            the CSV of ``analyze-experiment``), ``interfaces`` (``R_tot``, ``dR_sum`` [mm], ``R_slow``, ...) and
+            ``slip_events`` (:meth:`slip_events`); each with ``attrs["units"]``.
 
         Raises
         ------
@@ -285,7 +324,8 @@ class TimeseriesRun:
         """
         params = parse_params(ExperimentEventsParams, analysis_params, owner=f"analysis '{EXPERIMENT_EVENTS}'")
         slips, interfaces = analyse_record(self.record, params)
-        return {"slip_events": experimental_slip_events(slips), "slips": slips, "interfaces": interfaces}
+        return {name: with_units(table) for name, table in
+                (("slip_events", experimental_slip_events(slips)), ("slips", slips), ("interfaces", interfaces))}
 
     def slip_events(self, **analysis_params):
         """The run's slips as the results database holds them (``slip_events`` of :meth:`events`).
@@ -294,7 +334,7 @@ class TimeseriesRun:
         -------
         pandas.DataFrame
             ``event``, ``interface`` (a), ``multi``, ``slip`` (dR) [mm], ``dmu`` [-], ``time`` [s], then
-            ``dF`` [N], ``T`` [s], ``B_a``, ...
+            ``dF`` [N], ``T`` [s], ``B_a``, ...; ``attrs["units"]``.
         """
         return self.events(**analysis_params)["slip_events"]
 
@@ -314,7 +354,7 @@ class TimeseriesRun:
         -------
         stickslip.experiment.aging.AgingFit or dict[int, AgingFit or ValueError]
             ``B``, ``B_error``, ``c``, ``c_error`` [-], the bins (``T`` [s], ``dmu_mean``, ``dmu_std``,
-            ``count``) and ``n_slips``; per interface a dict by ``a``.
+            ``count``; ``attrs["units"]``) and ``n_slips``; per interface a dict by interface.
 
         Raises
         ------
@@ -323,7 +363,11 @@ class TimeseriesRun:
         """
         params = parse_params(ExperimentEventsParams, analysis_params, owner=f"analysis '{EXPERIMENT_EVENTS}'")
         slips, _ = analyse_record(self.record, params)
-        return fit_single_slips(slips, t0=params.t0, fit=fit, per_interface=per_interface)
+        fits = fit_single_slips(slips, t0=params.t0, fit=fit, per_interface=per_interface)
+        for each in fits.values() if per_interface else (fits,):
+            if hasattr(each, "bins"):
+                with_units(each.bins)
+        return fits
 
     def truth(self, table="truth"):
         """The ground truth of a virtual run: ``"truth"`` (one row per slip made) or ``"interfaces"``.
@@ -331,9 +375,12 @@ class TimeseriesRun:
         Returns
         -------
         pandas.DataFrame or None
-            None for lab data (:func:`stickslip.experiment.timeseries.read_truth`).
+            The file's table (:mod:`stickslip.solvers.lever`) in the vocabulary's names (``interface``, ``slip``:
+            the file's ``a``, ``dR``), with ``attrs["units"]``; None for lab data
+            (:func:`stickslip.experiment.timeseries.read_truth`).
         """
-        return read_truth(self.path, table)
+        found = read_truth(self.path, table)
+        return None if found is None else with_units(found.rename(columns={"a": "interface", "dR": "slip"}))
 
 
 #: The reader of every simulation format that :func:`open_run` opens.

@@ -87,7 +87,7 @@ def test_a_fem_run_reads_as_the_commands_and_the_workflow_write_it(fem_runs, tmp
     for name, table in tables.items():
         pd.testing.assert_frame_equal(table.reset_index(drop=True), stored[name], check_dtype=False, obj=name)
     slips = run.slip_events()
-    assert list(slips["increment"][:2]) == [30, 44] and (slips["dmu"] > 0).all()
+    assert list(slips["increment"][:2]) == [30, 44] and (slips["dmu_sig0"] > 0).all()
 
 
 @pytest.mark.slow
@@ -111,20 +111,24 @@ def test_a_fem_state_is_the_stored_state_with_the_fields_the_run_observed(fem_ru
         xx, yy, xy = run.state(inc).sig[0].reshape(-1, 3).mean(axis=0)
         sigd = 2.0 * math.sqrt((0.5 * (xx - yy)) ** 2 + xy ** 2) / sig0
         assert sigd == pytest.approx(increments.loc[inc, f"sigd_{interface_layer(1)}"], rel=1e-12)
-    with pytest.raises(FileFormatError, match=f"{cli.parent / 'api.h5'}: increment 81 is not stored"):
+    with pytest.raises(IndexError, match=f"{cli.parent / 'api.h5'}: increment 81 is not stored \\(0 ... 80\\)") as err:
         run.state(81)
+    assert isinstance(err.value, FileFormatError)  # as before this error class
 
 
 @pytest.mark.slow
 def test_a_replayed_event_is_the_stored_event(fem_runs):
     _, run = fem_runs
     failures = run.failures(44)
-    assert list(failures.columns) == ["a", "block", "t", "direction"]
+    assert list(failures.columns) == ["interface", "block", "t", "hop_direction"]
+    assert failures.attrs["units"] == {"interface": "", "block": "", "t": "time", "hop_direction": ""}
     assert (np.diff(failures["t"]) >= 0).all() and set(failures["block"]) == set(range(FEM["N"]))
-    net = failures.groupby("block")["direction"].sum()
+    net = failures.groupby("block")["hop_direction"].sum()
     assert int(net.sum()) == run.increments.loc[44, "S_a1"]
     with pytest.raises(FileFormatError, match="increment 43 is not a stored kick increment"):
         run.failures(43)  # a load step
+    with pytest.raises(IndexError, match="increment -1 is not stored"):
+        run.failures(-1)
 
 
 @pytest.mark.slow
@@ -134,7 +138,7 @@ def test_a_virtual_experiment_reads_as_analyze_experiment_writes_it(lever_runs, 
     status, text = _cli("analyze-experiment", cli, "-o", tmp_path / "slips.csv", "--aging")
     assert status == 0
     slips = run.events()["slips"]
-    written = pd.read_csv(tmp_path / "slips.csv").drop(columns="run")
+    written = pd.read_csv(tmp_path / "slips.csv").drop(columns="path")
     pd.testing.assert_frame_equal(slips, written, check_dtype=False, rtol=1e-15)
     fit = run.aging()
     assert text.splitlines()[-1] == f"B={fit.B:.4g} +- {fit.B_error:.2g}"

@@ -92,7 +92,7 @@ def test_database_mode_schema_version_and_wrong_files(toy_results, capsys, tmp_p
         status, text = _run("db", *command)
         err = capsys.readouterr().err
         assert status == 2 and err.count("\n") == 1 and "schema version 1, expected" in err
-        assert "stickslip db rebuild" in err
+        assert "stickslip db migrate" in err
     lab = tmp_path / "lab.h5"
     lab.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
     assert _run("db", "runs", "--db", str(lab))[0] == 2

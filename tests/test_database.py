@@ -1,9 +1,9 @@
 """The results database: ingest (idempotent, atomic, concurrent), schema, queries."""
 
-import json
 import multiprocessing
 import sqlite3
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -12,10 +12,10 @@ import pytest
 from stickslip.formats.event_table import read_slip_events
 from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.params import ParameterError, parse_params
 from stickslip.provenance import ingest as ingest_module
 from stickslip.provenance import query
-from stickslip.provenance.database import SCHEMA_VERSION
+from stickslip.provenance.database import SCHEMA_VERSION, create_schema, engine_for
 from stickslip.provenance.ingest import find_records, ingest
 from stickslip.provenance.record import read_record
 
@@ -137,8 +137,16 @@ def test_queries_are_read_only_and_filter(toy_results):
     assert len(query.events(database, interface=2)) == 0
     assert len(query.events(database, solver="toy-spring-block", seed=2)) == 4
     assert len(query.runs(database, plugin="toy-slips")) == 2
-    params = json.loads(query.runs(database, kind="solver", seed=1)["params"].iloc[0])
-    assert params["slips"] == 4 and params["seed"] == 1
+    run = query.runs(database, kind="solver", seed=1).iloc[0]
+    assert run["params.slips"] == 4 and run["params.seed"] == 1  # every parameter, a typed column
+    assert len(query.runs(database, slips=4)) == 2 and query.runs(database, slips=5).empty  # a plugin parameter
+    for bad, message in ((dict(kind="simulation"), "filter 'kind': 'simulation' is not allowed; expected one of"),
+                         (dict(plugin="toy-slip"), "values in this database: 'toy-force', 'toy-slips', "
+                                                   "'toy-spring-block' \\(did you mean 'toy-slips'\\?\\)"),
+                         (dict(slips="many"), "filter 'slips': expected an integer"),
+                         (dict(colour="red"), "unknown filter 'colour'")):
+        with pytest.raises(ParameterError, match=message):
+            query.runs(database, **bad)
     with pytest.raises(FileFormatError, match="no such database"):
         query.runs("results/missing.sqlite")
 
@@ -188,9 +196,55 @@ def test_the_periodicity_of_a_numerical_run_goes_to_its_table_and_view(tmp_path,
     row = query.sql("SELECT * FROM periodicity_full", "db.sqlite")
     expected = tables["periodicity"].iloc[0]
     assert len(row) == 1 and row["simulation_run_id"].iloc[0] == "0123456789abcdef"
-    assert row["slips"].iloc[0] == expected["slips"] and row["multi"].iloc[0] == expected["multi"]
+    assert row["n_slips"].iloc[0] == expected["n_slips"] and row["n_multi"].iloc[0] == expected["n_multi"]
     assert row["interval_cv"].iloc[0] == pytest.approx(expected["interval_cv"])
     assert row["alternation_cv"].isna().iloc[0] == np.isnan(expected["alternation_cv"])  # NaN is NULL
     assert row["phi"].isna().iloc[0]  # the simulation itself was not ingested: its columns are NULL
     ingest("db.sqlite", ["events/abc.provenance.json"])  # idempotent
     assert len(query.sql("SELECT * FROM run_periodicity", "db.sqlite")) == 1
+
+
+def test_a_schema_6_database_migrates_to_this_schema_keeping_its_rows(tmp_path):
+    """stickslip db migrate: a database written by c47ca12 (tests/data/schema6.sql) reads as this schema's."""
+    from stickslip.cli import main
+    from stickslip.provenance.migrate import migrate
+
+    database = tmp_path / "stickslip.sqlite"
+    with sqlite3.connect(database) as connection:
+        connection.executescript((Path(__file__).parent / "data" / "schema6.sql").read_text())
+        old = {row[0]: row[1:] for row in connection.execute("SELECT id, dmu, time, source FROM slip_events")}
+        connection.execute("INSERT INTO slip_events (id, analysis_run_id, simulation_run_id, analysis, solver, source, "
+                           "event, interface, dmu, multi, time, increment, extra) SELECT 999, analysis_run_id, "
+                           "simulation_run_id, 'thermal-events', solver, source, 0, 1, 0.5, 0, 12.5, 3, "
+                           "'{\"T\": 2.0, \"B_a\": 0.7, \"mu_before\": 1.5, \"hold\": 0.0}' FROM slip_events "
+                           "WHERE source = 'numerical' LIMIT 1")
+        sims = connection.execute("SELECT run_id, a FROM simulations ORDER BY run_id").fetchall()
+    with pytest.raises(query.QueryError, match="database schema version 6, expected 7: run `stickslip db migrate`"):
+        query.events(database)
+    assert migrate(database) == (6, SCHEMA_VERSION)
+    events = query.events(database).set_index("id")
+    for row, (dmu, time_, source) in old.items():
+        numerical = source == "numerical"
+        assert events.loc[row, "dmu_sig0" if numerical else "dmu"] == dmu
+        assert pd.isna(events.loc[row, "dmu" if numerical else "dmu_sig0"])
+        assert events.loc[row, "time"] == time_ if time_ is not None else pd.isna(events.loc[row, "time"])
+    thermal = events.loc[999]
+    assert (thermal["dmu_sig0"], thermal["t"], thermal["T_fe"], thermal["B_a_sig0"], thermal["mu_before_sig0"],
+            thermal["hold"]) == (0.5, 12.5, 2.0, 0.7, 1.5, 0.0)
+    assert pd.isna(thermal["dmu"]) and pd.isna(thermal["time"]) and pd.isna(thermal["T"])
+    experimental = events[events["source"] == "experimental"]
+    assert experimental["slip_from_dF"].notna().all() and "dR_from_dF" not in events.columns
+    assert events["multi"].dtype == bool
+    assert query.sql("SELECT run_id, driven_slab FROM simulations ORDER BY run_id", database).astype(object).where(
+        lambda f: f.notna(), None).values.tolist() == [list(row) for row in sims]
+    periodicity = query.sql("SELECT n_slips, n_multi, n_spanning FROM periodicity_full", database)
+    assert len(periodicity) == 1 and periodicity["n_slips"].iloc[0] >= periodicity["n_multi"].iloc[0]
+    # every table and view has this schema's columns (a migrated table may order them otherwise)
+    fresh = tmp_path / "fresh.sqlite"
+    create_schema(engine_for(fresh), "test")
+    for table in ("runs", "artifacts", "simulations", "slip_events", "run_periodicity", "figures", "slip_events_full",
+                  "periodicity_full"):
+        columns = [query.sql(f"PRAGMA table_info({table})", path)["name"].tolist() for path in (database, fresh)]
+        assert sorted(columns[0]) == sorted(columns[1]), table
+    assert migrate(database) == (SCHEMA_VERSION, SCHEMA_VERSION)
+    assert main(["db", "migrate", "--db", str(database)]) == 0

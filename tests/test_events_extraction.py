@@ -121,7 +121,7 @@ def test_slip_events_and_their_interfaces():
     assert slips["increment"].tolist() == [8, 12, 14, 16, 18, 22, 24]
     assert slips["interfaces"].tolist() == ["2", "1", "1,2", "1,2", "2", "1", "1,2"]
     assert slips["s"].tolist() == [1, 1, 2, 2, 1, 1, 2]
-    assert slips["single"].tolist() == [True, True, False, False, True, True, False]
+    assert slips["multi"].tolist() == [False, False, True, True, False, False, True]
     np.testing.assert_allclose(slips["gamma"], [4, 6, 7, 8, 9, 11, 12])
     np.testing.assert_allclose(slips["dsigma"], [1.25, 0.75, 1.5, 1.5, 1.25, 0.75, 1.5])
     np.testing.assert_allclose(slips["sigma_before"] - slips["sigma_after"], slips["dsigma"])
@@ -130,15 +130,15 @@ def test_slip_events_and_their_interfaces():
 def test_stress_drop_and_shear_since_the_previous_slip_of_the_same_interface():
     classified = ex.classify_increments(history(N, EVENTS), N)
     per = ex.slip_interfaces(classified, N)
-    one = per[per["a"] == 1]
-    two = per[per["a"] == 2]
+    one = per[per["interface"] == 1]
+    two = per[per["interface"] == 2]
     assert one["increment"].tolist() == [12, 14, 16, 22, 24]
-    np.testing.assert_allclose(one["dmu"], [1.5, 1.0, 1.0, 1.5, 1.0])
+    np.testing.assert_allclose(one["dmu_sig0"], [1.5, 1.0, 1.0, 1.5, 1.0])
     # gamma of interface-1 slips: 6, 7, 8, 11, 12 (multi-slips count, the transient slip at 2 does not)
     np.testing.assert_allclose(one["dgamma"], [np.nan, 1, 1, 3, 1])
-    assert one["single"].tolist() == [True, False, False, True, False]
+    assert one["multi"].tolist() == [False, True, True, False, True]
     assert two["increment"].tolist() == [8, 14, 16, 18, 24]
-    np.testing.assert_allclose(two["dmu"], [2.5, 2.0, 2.0, 2.5, 2.0])
+    np.testing.assert_allclose(two["dmu_sig0"], [2.5, 2.0, 2.0, 2.5, 2.0])
     np.testing.assert_allclose(two["dgamma"], [np.nan, 3, 1, 1, 3])
     assert per["increment"].is_monotonic_increasing
 

@@ -44,7 +44,7 @@ def test_numerical_events_of_a_fem_run(fem_run, tmp_path):
         assert row["kick"]
         assert [a for a in (1, 2) if row[f"A_a{a}"] == N] == [int(a) for a in slip["interfaces"].split(",")]
     # the slipping interface and the whole system relax in a slip
-    assert (per["dmu"] > 0).all() and (slips["dsigma"] > 0).all()
+    assert (per["dmu_sig0"] > 0).all() and (slips["dsigma"] > 0).all()
     # load steps are elastic: nothing yields
     loads = raw[~raw["kick"].to_numpy(dtype=bool)]
     assert (loads[["A_a1", "A_a2", "S_a1", "S_a2"]].to_numpy() == 0).all()
@@ -88,8 +88,8 @@ def test_worked_example_of_the_developers_guide_runs(fem_run, tmp_path):
     largest = read_slip_events(tmp_path / "largest.h5")
     everything = read_slip_events_of_run(fem_run, tmp_path)
     for a, rows in largest.groupby("interface"):
-        expected = everything[everything["interface"] == a]["dmu"].nlargest(2)
-        np.testing.assert_array_equal(np.sort(rows["dmu"].to_numpy()), np.sort(expected.to_numpy()))
+        expected = everything[everything["interface"] == a]["dmu_sig0"].nlargest(2)
+        np.testing.assert_array_equal(np.sort(rows["dmu_sig0"].to_numpy()), np.sort(expected.to_numpy()))
     item = Artifact(tmp_path / "largest.h5", "0" * 16, "largest-slips", "event-table", fem_run)
     figure_module.run(figure_module.LargestFigureParams(), {"analysis:largest-slips": [item]}, tmp_path / "f.pdf")
     assert (tmp_path / "f.pdf").stat().st_size > 1000 and (tmp_path / "f.png").stat().st_size > 1000

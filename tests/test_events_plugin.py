@@ -43,10 +43,10 @@ def test_slip_events_are_the_per_interface_slips_numbered_by_event(tmp_path):
     tables = write(tmp_path / "events.h5")
     table = read_slip_events(tmp_path / "events.h5")
     per = tables["slip_interfaces"]
-    assert list(table.columns) == ["event", "interface", "multi", "dmu", "increment", "dgamma"]
-    np.testing.assert_array_equal(table["interface"], per["a"])
-    np.testing.assert_array_equal(table["dmu"], per["dmu"])
-    np.testing.assert_array_equal(table["multi"], ~per["single"].to_numpy(dtype=bool))
+    assert list(table.columns) == ["event", "interface", "multi", "dmu_sig0", "increment", "dgamma"]
+    np.testing.assert_array_equal(table["interface"], per["interface"])
+    np.testing.assert_array_equal(table["dmu_sig0"], per["dmu_sig0"])
+    np.testing.assert_array_equal(table["multi"], per["multi"])
     # one event number per slipping increment, counted from 0 in increment order
     assert table.groupby("event")["increment"].nunique().eq(1).all()
     assert table["event"].tolist() == table["increment"].rank(method="dense").astype(int).sub(1).tolist()

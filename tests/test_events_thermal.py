@@ -84,15 +84,15 @@ def test_waiting_times_are_the_clock_between_slips_of_an_interface(study):
     rows = np.searchsorted(table["increment"].to_numpy()[full], slips["increment"].to_numpy())
     expected = np.where(rows > 0, t[rows] - t[np.maximum(rows - 1, 0)], np.nan)
     assert len(slips) >= 3
-    np.testing.assert_array_equal(slips["T"].to_numpy(), expected)
-    np.testing.assert_array_equal(slips["B_a"].to_numpy()[rows > 0],
-                                  slips["dmu"].to_numpy()[rows > 0] / np.log(expected[rows > 0]))
+    np.testing.assert_array_equal(slips["T_fe"].to_numpy(), expected)
+    np.testing.assert_array_equal(slips["B_a_sig0"].to_numpy()[rows > 0],
+                                  slips["dmu_sig0"].to_numpy()[rows > 0] / np.log(expected[rows > 0]))
     assert np.all(slips["hold"].to_numpy()[rows > 0] == 0.0)  # this run has no holds of its own
 
 
 def test_an_athermal_run_has_no_clock_and_no_hold_trials(study):
     tables = _tables(study[figs_thermal.THERMAL][4])
-    assert np.all(np.isnan(tables["slip_events"]["T"])) and np.all(np.isnan(tables["slip_events"]["time"]))
+    assert np.all(np.isnan(tables["slip_events"]["T_fe"])) and np.all(np.isnan(tables["slip_events"]["t"]))
     assert tables["holds"].empty and tables["barriers"].empty
     assert 0.0 <= tables["interfaces"]["R_slow"].iloc[0] < 1.0
 
@@ -170,19 +170,20 @@ def test_the_figure_plots_the_numbers_of_its_runs(study):
     # (a) slide-hold-slide: every single slip with a waiting time (T0 = 1 / attempt_rate = 1) and the fit through
     # the origin, dmu = B ln(nu T)
     slips = shs["slip_events"]
-    slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
+    slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T_fe"].to_numpy(dtype=float))]
     assert len(slips) >= 5
     a = figure.axes[0]
     [points] = [line for line in a.get_lines() if line.get_marker() == "o" and line.get_linestyle() == "None"]
-    np.testing.assert_array_equal(points.get_xdata(), slips["T"].to_numpy(float))
-    np.testing.assert_array_equal(points.get_ydata(), slips["dmu"].to_numpy(float))
-    bins = log_binned(slips["T"].to_numpy(float), slips["dmu"].to_numpy(float), bins_per_decade=params.bins_per_decade)
+    np.testing.assert_array_equal(points.get_xdata(), slips["T_fe"].to_numpy(float))
+    np.testing.assert_array_equal(points.get_ydata(), slips["dmu_sig0"].to_numpy(float))
+    bins = log_binned(slips["T_fe"].to_numpy(float), slips["dmu_sig0"].to_numpy(float),
+                      bins_per_decade=params.bins_per_decade)
     [squares] = [line for line in a.get_lines() if line.get_marker() == "s"]  # binned means
     np.testing.assert_array_equal(squares.get_xdata(), bins["T"].to_numpy())
     np.testing.assert_array_equal(squares.get_ydata(), bins["dmu_mean"].to_numpy())
     dotted = [line for line in a.get_lines() if line.get_linestyle() == ":"]
     try:
-        fit = fit_aging(slips["T"].to_numpy(float), slips["dmu"].to_numpy(float), t0=1.0, fit="origin",
+        fit = fit_aging(slips["T_fe"].to_numpy(float), slips["dmu_sig0"].to_numpy(float), t0=1.0, fit="origin",
                         bins_per_decade=params.bins_per_decade)
     except ValueError:  # too few slips per bin in this small run: no fit drawn
         assert dotted == []

@@ -58,8 +58,8 @@ def test_spread_of_aging_rate_is_normalised_by_the_interface_alone():
                                    ("stack", 1, 1, 0.5), ("stack", 3, 1, 0.03), ("stack", 3, 2, 0.02)]:
         for b in 0.05 + spread * rng.standard_normal(4000):
             rows.append((protocol, n, a, b))
-    table = aging.spread_of_aging_rate(pd.DataFrame(rows, columns=["protocol", "n", "a", "B_a"]))
-    table = table.set_index(["a", "n"])
+    table = aging.spread_of_aging_rate(pd.DataFrame(rows, columns=["protocol", "n", "interface", "B_a"]))
+    table = table.set_index(["interface", "n"])
     assert table.loc[(1, 1), "std"] == pytest.approx(0.01, rel=0.05)  # individual, not stack n = 1
     assert table.loc[(1, 3), "std_normalised"] == pytest.approx(3.0, rel=0.05)
     assert table.loc[(2, 3), "std_normalised"] == pytest.approx(1.0, rel=0.05)
@@ -103,7 +103,7 @@ def test_per_interface_fits_recover_each_rate():
     rows = []
     for a, B in rates.items():
         T = 10.0 ** rng.uniform(0.5, 3.0, 800)
-        rows.append(pd.DataFrame({"a": a, "T": T, "dmu": 0.1 + B * np.log(T) + rng.normal(0, 0.01, T.size)}))
+        rows.append(pd.DataFrame({"interface": a, "T": T, "dmu": 0.1 + B * np.log(T) + rng.normal(0, 0.01, T.size)}))
     fits = aging.fit_aging_per_interface(pd.concat(rows), fit="intercept")
     assert sorted(fits) == [1, 2]
     for a, B in rates.items():

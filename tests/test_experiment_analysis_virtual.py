@@ -42,7 +42,8 @@ def _match(path):
     middle = 0.5 * (truth["t_start"] + truth["t_end"]).to_numpy()
     found = np.full(len(truth), -1)
     for k, (a, t) in enumerate(zip(truth["a"], middle)):
-        candidates = np.flatnonzero((slips["a"].to_numpy() == a) & (np.abs(slips["t"].to_numpy() - t) < 0.6))
+        near = np.abs(slips["time"].to_numpy() - t) < 0.6
+        candidates = np.flatnonzero((slips["interface"].to_numpy() == a) & near)
         if candidates.size:
             found[k] = candidates[0]
     return slips, interfaces, truth, found
@@ -60,20 +61,20 @@ def test_every_slip_found_with_its_interface_and_amplitudes(stack_run):
     assert len(set(found)) == len(slips) == len(truth)  # one to one: no false slip anywhere
     matched = slips.iloc[found].reset_index(drop=True)
     assert not matched["multi"].any()
-    assert np.max(np.abs(matched["dR"] - truth["dR"])) < 5 * DR_SIGMA
+    assert np.max(np.abs(matched["slip"] - truth["dR"])) < 5 * DR_SIGMA
     assert np.max(np.abs(matched["dF"] - truth["dF"])) < 6 * DF_SIGMA
     # dmu_a = (H/h) 2/(n+a) dF/N: the friction drop of the truth within the force noise.
     dmu_sigma = 100 / 10 * 2 / (3 + truth["a"]) * DF_SIGMA / 49
     assert np.all(np.abs(matched["dmu"] - truth["dmu"]) < 6 * dmu_sigma)
     # dR predicted from dF agrees with the measured dR (fig. 3c) within both noises.
-    assert np.max(np.abs(matched["dR_from_dF"] - matched["dR"])) < 5 * DR_SIGMA + 6 * DF_SIGMA * 100 / (55 * 10 * 3)
+    assert np.max(np.abs(matched["slip_from_dF"] - matched["slip"])) < 5 * DR_SIGMA + 6 * DF_SIGMA * 100 / (55 * 10 * 3)
     # T from the frame of the largest displacement: within one frame of the truth.
     both = np.isfinite(truth["T"]) & np.isfinite(matched["T"])
     assert np.max(np.abs(matched["T"][both] - truth["T"][both])) < 0.25
     # Slow slip: the sliding not done by detected slips is the creep of the truth.
     solver = read_truth(stack_run, "interfaces").set_index("a")
     for a in (1, 2, 3):
-        row = interfaces.set_index("a").loc[a]
+        row = interfaces.set_index("interface").loc[a]
         creep = 1.0 - solver.loc[a, "slip_total"] / solver.loc[a, "R_total"]
         assert row["R_slow"] == pytest.approx(creep, abs=0.03)
 
@@ -83,10 +84,10 @@ def test_individual_protocol_amplitudes(tmp_path):
     slips, _, truth, found = _match(path)
     assert np.all(found >= 0) and len(slips) == len(truth) > 5
     matched = slips.iloc[found].reset_index(drop=True)
-    np.testing.assert_array_equal(matched["a"], 2)
+    np.testing.assert_array_equal(matched["interface"], 2)
     # Individual: dmu = dF H / (N a h); dR = dF H / (K a h).
     assert np.max(np.abs(matched["dmu"] - truth["dmu"])) < 6 * DF_SIGMA * 100 / (49 * 2 * 10)
-    assert np.max(np.abs(matched["dR_from_dF"] - truth["dR"])) < 6 * DF_SIGMA * 100 / (55 * 2 * 10)
+    assert np.max(np.abs(matched["slip_from_dF"] - truth["dR"])) < 6 * DF_SIGMA * 100 / (55 * 2 * 10)
 
 
 def test_simultaneous_slips_are_flagged_never_assigned(tmp_path):
@@ -132,7 +133,7 @@ def test_plugin_file_is_reproducible_and_cli_prints_B(stack_run, tmp_path):
     assert len(digests) == 1
     with open_file(tmp_path / "a.h5") as f:
         slips = read_table(f, "slips")
-        assert {"t", "a", "n", "protocol", "dF", "dmu", "T", "dR", "dR_from_dF", "B_a", "multi",
+        assert {"time", "interface", "n", "protocol", "dF", "dmu", "T", "slip", "slip_from_dF", "B_a", "multi",
                 "slow_slip_before", "t_start", "t_end"} <= set(slips.columns)
         assert int(f.attrs["n"]) == 3 and f.attrs["protocol"] == "stack" and int(f.attrs["seed"]) == 1
         assert read_table(f, "interfaces")["n_slips"].sum() == len(slips)
@@ -142,7 +143,7 @@ def test_plugin_file_is_reproducible_and_cli_prints_B(stack_run, tmp_path):
     last = done.stdout.strip().splitlines()[-1]
     value, error = last.removeprefix("B=").split(" +- ")
     assert 0.02 < float(value) < 0.1 and 0 < float(error) < float(value)
-    assert csv.read_text().splitlines()[0].startswith("event,t,a,n,protocol,multi")
+    assert csv.read_text().splitlines()[0].startswith("event,time,interface,n,protocol,multi")
 
 
 def _per_interface_fits(stdout):

@@ -29,7 +29,7 @@ pytestmark = pytest.mark.slow
 def numba_cuda():
     """numba-cuda is installed (skip, or fail where .ci/run requires it)."""
     if importlib.util.find_spec("numba_cuda") is None:
-        reason = "numba-cuda is not installed (pip install stickslip[gpu])"
+        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
         if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
             pytest.fail(reason)
         pytest.skip(reason)

@@ -32,7 +32,7 @@ TIMEOUT = int(os.environ.get("STICKSLIP_CUDA_SIM_TIMEOUT", "900"))
 @pytest.fixture(scope="module", autouse=True)
 def numba_cuda():
     if importlib.util.find_spec("numba_cuda") is None:
-        reason = "numba-cuda is not installed (pip install stickslip[gpu])"
+        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
         if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
             pytest.fail(reason)
         pytest.skip(reason)

@@ -97,7 +97,7 @@ def test_inputs_without_run_attributes_are_refused(tmp_path):
 
     path = tmp_path / "other.h5"
     with open_file(path, "w") as f:
-        write_table(f, "slips", pd.DataFrame({"a": [1]}))
+        write_table(f, "slips", pd.DataFrame({"interface": [1]}))
     with pytest.raises(FileFormatError, match="no 'format' attribute"):
         experimental_data.load_slips([path])
     with open_file(path, "r+") as f:
@@ -170,11 +170,11 @@ def test_fig6_spread_median_run_and_standard_errors(study):
             assert np.all(np.diff(x) == 1.0)
     assert any(len(container.lines[2]) for container in spread.containers)
     interfaces = experimental_data.load_interfaces(study[experimental_data.EVENTS])
-    runs = interfaces[(interfaces["protocol"] == "stack") & (interfaces["n"] == 5) & (interfaces["a"] == 2)]
+    runs = interfaces[(interfaces["protocol"] == "stack") & (interfaces["n"] == 5) & (interfaces["interface"] == 2)]
     note = next(text.get_text() for text in example.texts if "median" in text.get_text())
     shown = float(re.search(r": (-?[0-9.]+)\s+\(", note)[1])
     assert shown == pytest.approx(np.sort(runs["R_slow"].to_numpy())[(len(runs) - 1) // 2], abs=5e-4)
-    one = interfaces[(interfaces["protocol"] == "stack") & (interfaces["a"] == 1)].groupby("n")["R_slow"]
+    one = interfaces[(interfaces["protocol"] == "stack") & (interfaces["interface"] == 1)].groupby("n")["R_slow"]
     bars = fraction.containers[0]                  # interface 1, n = 1..5
     half = np.array([segment[1, 1] - segment[0, 1] for segment in bars.lines[2][0].get_segments()]) / 2
     np.testing.assert_allclose(half, one.sem().to_numpy(), rtol=1e-9)
@@ -202,7 +202,7 @@ def test_figs_slow_slip_shows_the_shuffled_control(study):
     fig = _draw("figS-slow-slip", study)
     shuffled = [container for container in fig.axes[2].containers if container.lines[0].get_gid() == "shuffled"]
     every = experimental_data.load_interfaces(study[experimental_data.EVENTS], shuffled=True)
-    expected = every[every["shuffled"] & every["driven"]].sort_values("a")["R_slow"].to_numpy()
+    expected = every[every["shuffled"] & every["driven"]].sort_values("interface")["R_slow"].to_numpy()
     plotted = np.array([container.lines[0].get_ydata()[0] for container in shuffled])
     assert [container.lines[0].get_xdata()[0] for container in shuffled] == [5.3] * 5
     np.testing.assert_allclose(plotted, expected)

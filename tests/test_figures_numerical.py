@@ -100,7 +100,7 @@ def _check_dgamma(figure, study):
     # stiff panel, n = 1: the legend counts the finite slip-to-slip increments of interface 1
     files = _read(study, "analysis:numerical-events", ("slip_interfaces",))
     per = pooled([f for f in files if (f.regime, f.n) == ("stiff", 1)], "slip_interfaces")
-    count = int(np.isfinite(per["dgamma"][per["a"] == 1]).sum())
+    count = int(np.isfinite(per["dgamma"][per["interface"] == 1]).sum())
     assert count > 10
     assert f"$n = 1$ ({count})" in [text.get_text() for text in figure.axes[0].get_legend().get_texts()]
 

@@ -42,7 +42,7 @@ def test_the_reader_refuses_other_files_and_names_what_is_missing(tmp_path):
     tables = plugin.event_tables(history(N, EVENTS), N)
     plugin.write_event_file(tables, plugin.event_attrs(run_attrs(N, 3, 1e-3), tables["increments"]),
                             tmp_path / "events.h5", input=__file__)
-    with pytest.raises(FileFormatError, match="a event-table file version 1, expected front-table"):
+    with pytest.raises(FileFormatError, match="a event-table file version 2, expected front-table"):
         front_table.read_front_tables(tmp_path / "events.h5")
     _write(tmp_path / "fronts.h5")
     with h5py.File(tmp_path / "fronts.h5", "r+") as file:

@@ -90,7 +90,7 @@ def test_import_csv_and_mesh(tmp_path, capsys):
     arguments = csv_files(tmp_path)
     assert main(["import-csv", *arguments, "-o", str(output)]) == 0
     assert main(["import-csv", *arguments, "-o", str(output)]) == 0  # the same import
-    err = refused(capsys, ["import-csv", *arguments, "--V", "0.02", "-o", str(output)], output)
+    err = refused(capsys, ["import-csv", *arguments, "--lever-speed", "0.02", "-o", str(output)], output)
     assert "with V = 0.01 (this run: 0.02)" in err
     (tmp_path / "force.csv").write_text(FORCE.replace("2.7", "2.8"))  # another export
     err = refused(capsys, ["import-csv", *arguments, "-o", str(output)], output)

@@ -21,7 +21,7 @@ def test_a_perfectly_periodic_sequence():
     """Equal intervals and drops, the pattern single, single, multi (all 3 interfaces) repeated."""
     pattern = np.tile([1, 1, 3], 20)
     row = pe.periodicity(slips(np.arange(60) * 2.5, pattern, np.full(60, 0.3)), n=3)
-    assert row["slips"] == 60 and row["multi"] == 20 and row["spanning"] == 20
+    assert row["n_slips"] == 60 and row["n_multi"] == 20 and row["n_spanning"] == 20
     assert row["interval_cv"] == pytest.approx(0.0, abs=1e-12) and row["drop_cv"] == pytest.approx(0.0, abs=1e-12)
     assert row["multi_fraction"] == pytest.approx(1 / 3) and row["spanning_fraction"] == pytest.approx(1 / 3)
     assert row["alternation_cv"] == 0.0  # always two singles between multis
@@ -31,7 +31,7 @@ def test_a_perfectly_periodic_sequence():
 
 def test_multi_slips_that_do_not_span_the_stack():
     row = pe.periodicity(slips([0, 1, 2, 3], [2, 2, 3, 1], [1, 1, 1, 1]), n=3)
-    assert row["multi_fraction"] == 0.75 and row["spanning_fraction"] == 0.25 and row["spanning"] == 1
+    assert row["multi_fraction"] == 0.75 and row["spanning_fraction"] == 0.25 and row["n_spanning"] == 1
 
 
 def test_strict_alternation_and_clustering_by_the_runs_test():
@@ -63,7 +63,7 @@ def test_undefined_with_too_few_events():
     assert math.isnan(row["interval_cv"]) and math.isnan(row["alternation_cv"]) and math.isnan(row["runs_z"])
     assert row["drop_cv"] == pytest.approx(0.0, abs=1e-12)
     empty = pe.periodicity(slips([], [], []), n=2)
-    assert empty["slips"] == 0 and math.isnan(empty["multi_fraction"]) and math.isnan(empty["drop_cv"])
+    assert empty["n_slips"] == 0 and math.isnan(empty["multi_fraction"]) and math.isnan(empty["drop_cv"])
 
 
 def test_from_an_increment_table_through_the_event_file_tables():
@@ -73,7 +73,7 @@ def test_from_an_increment_table_through_the_event_file_tables():
     tables = event_tables(history(N, events), N)
     row = tables[pe.TABLE].iloc[0]
     steady = tables["slips"]
-    assert row["slips"] == len(steady) == 17 and row["multi"] == 8 == row["spanning"]
+    assert row["n_slips"] == len(steady) == 17 and row["n_multi"] == 8 == row["n_spanning"]
     # gamma grows by 1 per event: intervals 2 (over a micro event) and 1 alternate in the pattern
     intervals = np.diff(steady["gamma"].to_numpy())
     assert row["interval_cv"] == pytest.approx(np.std(intervals, ddof=1) / np.mean(intervals))
@@ -88,7 +88,7 @@ def test_seed_summary_is_the_mean_and_standard_error_over_runs():
                          for g in ([1, 1, 1, 1], [1, 2, 1, 2], [1, 3, 1, 3])])
     summary = pe.seed_summary(rows, ["N", "n"])
     cv = rows["interval_cv"].to_numpy()
-    assert summary.loc[0, "runs"] == 3 and summary.loc[0, "slips"] == 12
+    assert summary.loc[0, "runs"] == 3 and summary.loc[0, "n_slips"] == 12
     assert summary.loc[0, "interval_cv"] == pytest.approx(cv.mean())
     assert summary.loc[0, "interval_cv_error"] == pytest.approx(cv.std(ddof=1) / math.sqrt(3))
     assert summary.loc[0, "alternation_cv_runs"] == 0  # two multis per run: undefined everywhere

@@ -23,7 +23,7 @@ def test_wilson_interval_brackets_the_fraction_and_shrinks_as_one_over_root_m():
 def _file(n, phi, seed, s, dmu):
     slips = pd.DataFrame({"increment": np.arange(len(s)), "s": s})
     rows = [(i, a, d) for i, (k, d) in enumerate(zip(s, dmu)) for a in range(k)]
-    per = pd.DataFrame(rows, columns=["increment", "a", "dmu"])
+    per = pd.DataFrame(rows, columns=["increment", "interface", "dmu_sig0"])
     return AnalysisFile(path=f"{n}-{phi}-{seed}", attrs={"n_interfaces": n, "phi": phi, "N": 27, "seed": seed},
                         tables={"slips": slips, "slip_interfaces": per})
 

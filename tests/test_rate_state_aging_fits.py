@@ -32,7 +32,7 @@ def _stack_runs(tmp_path):
             path = tmp_path / f"stack{n}-{seed}.h5"
             plugin.run(parse_params(plugin.params, {"n": n, "seed": seed}), path, threads=1, inputs={})
             detected.append(analyse_record(read_timeseries(path))[0])
-            truth.append(read_truth(path))
+            truth.append(read_truth(path).rename(columns={"a": "interface"}))  # the vocabulary's name
             interfaces.append(read_truth(path, "interfaces"))
 
     def single(slips):

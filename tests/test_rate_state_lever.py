@@ -319,7 +319,7 @@ def test_experimental_analysis_recovers_the_ground_truth(tmp_path):
     assert len(truth) > 30
     found, errors = 0, []
     for row in truth.itertuples():
-        same = detected[(detected["a"] == row.a) & ((detected["t"] - row.t_start).abs() < 1.5)]
+        same = detected[(detected["interface"] == row.a) & ((detected["time"] - row.t_start).abs() < 1.5)]
         if len(same):
             found += 1
             if not row.multi and not same["multi"].iloc[0]:

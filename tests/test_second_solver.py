@@ -52,7 +52,7 @@ def test_a_second_solver_needs_no_edit_of_the_package(tmp_path, toy_distribution
         simulations = connection.execute("SELECT solver, format, source, n, blocks, regime FROM simulations").fetchall()
         events = connection.execute("SELECT solver, source, COUNT(*) FROM slip_events GROUP BY solver").fetchall()
         fronts = connection.execute("SELECT COUNT(*) FROM runs WHERE plugin = 'front-dynamics'").fetchone()[0]
-        periodicity = connection.execute("SELECT solver, blocks, regime, dt_scale, slips FROM periodicity_full").fetchall()
+        periodicity = connection.execute("SELECT solver, blocks, regime, dt_scale, n_slips FROM periodicity_full").fetchall()
     assert simulations == [("fem-twin", "fem-run", "numerical", 2, 9, "compliant")]
     assert len(events) == 1 and events[0][:2] == ("fem-twin", "numerical") and events[0][2] > 0
     assert fronts == 1

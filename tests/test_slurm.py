@@ -162,7 +162,7 @@ def test_ci_study_through_slurm_equals_the_local_run(cluster, ci_study, tmp_path
     for query in ("SELECT run_id, kind, plugin, params FROM runs", "SELECT * FROM simulations",
                   "SELECT run_id, direction, role, path, sha256, format, made_by FROM artifacts WHERE path LIKE '%.h5'",
                   "SELECT analysis_run_id, simulation_run_id, analysis, solver, source, event, interface, slip, dmu, "
-                  "multi, time, increment, extra FROM slip_events"):
+                  "dmu_sig0, multi, time, t, increment, extra FROM slip_events"):
         assert table(remote / study.path("database"), query) == table(local / study.path("database"), query)
     again, output = run_snakemake(remote, env, *SLURM, *CI, "-n", timeout=300)
     assert again == 0 and "Nothing to be done" in output

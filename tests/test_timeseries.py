@@ -124,7 +124,7 @@ def test_a_stack_recording_without_a_is_read_and_analysed(tmp_path):
         np.testing.assert_array_equal(getattr(read[1], field.name), getattr(read[0], field.name))
     for path in (with_a, without_a):
         assert main(["analyze-experiment", str(path), "-o", str(path.with_suffix(".csv"))]) == 0
-    slips = [pd.read_csv(path.with_suffix(".csv")).drop(columns="run") for path in (with_a, without_a)]
+    slips = [pd.read_csv(path.with_suffix(".csv")).drop(columns="path") for path in (with_a, without_a)]
     assert len(slips[0]) > 0
     pd.testing.assert_frame_equal(slips[0], slips[1])
 
@@ -174,7 +174,7 @@ def test_a_lab_file_in_the_documented_layout_is_read_as_version_1(tmp_path, caps
         np.testing.assert_array_equal(getattr(back, field.name), getattr(signals, field.name))
     for path in (ours, lab):
         assert main(["analyze-experiment", str(path), "-o", str(path.with_suffix(".csv"))]) == 0
-    slips = [pd.read_csv(path.with_suffix(".csv")).drop(columns="run") for path in (ours, lab)]
+    slips = [pd.read_csv(path.with_suffix(".csv")).drop(columns="path") for path in (ours, lab)]
     assert len(slips[0]) > 0
     pd.testing.assert_frame_equal(slips[0], slips[1])
 

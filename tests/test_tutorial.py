@@ -1,9 +1,13 @@
-"""docs/tutorial.md runs: every code block in order, and each prints the output shown after it.
+"""docs/tutorial.md runs: every code block in order, each prints the output shown after it, and the repository
+is left as it was (the tutorial's files go to its temporary folder ``work``).
 
 The blocks run in one fresh Python process and one namespace, as in a notebook's kernel (this module,
 run as a script, is that process), in a copy of the workflow that holds the ci study's results (the
 session's ``ci_study``, run by `snakemake --cores 2` once for the tests that share it): the tutorial's
 own `snakemake` block runs there and finds the study done instead of computing it a second time (~1 min).
+(The blocks are not run in a Jupyter kernel through jupytext and nbclient: that would add ipykernel,
+jupyter_client, pyzmq and debugpy, ~40 MB, to CI for this one test; this runner executes the same code in
+one process and namespace, as the kernel would, and compares the printed text.)
 """
 
 import contextlib
@@ -42,9 +46,9 @@ def tutorial_blocks(text):
     return blocks
 
 
-def run_blocks(blocks):
-    """Run the blocks in order in this process; yield (line, what a python block printed, or the error)."""
-    namespace = {"__name__": "__tutorial__"}
+def run_blocks(blocks, namespace):
+    """Run the blocks in order in this process, in ``namespace``; yield (line, what a python block printed, or
+    the error)."""
     for language, code, line, _ in blocks:
         if language == "bash":
             done = subprocess.run(["bash", "-euo", "pipefail", "-c", code], capture_output=True, text=True)
@@ -73,16 +77,25 @@ def test_the_tutorial_has_blocks_with_outputs():
     assert sum(shown is not None for *_, shown in blocks) >= 8
 
 
+def _files(directory):
+    """Every file under ``directory`` but the study's results and Snakemake's state (ignored by git)."""
+    return sorted(str(path.relative_to(directory)) for path in directory.rglob("*")
+                  if path.relative_to(directory).parts[0] not in ("results", ".snakemake"))
+
+
 @pytest.mark.slow
 def test_every_block_of_the_tutorial_runs_and_prints_what_it_shows(ci_study, tmp_path):
     directory = tmp_path / "repository"
     shutil.copytree(ci_study, directory, symlinks=True)
-    environment = dict(os.environ, MPLBACKEND="Agg",
+    before = _files(directory)
+    environment = dict(os.environ, MPLBACKEND="Agg", TMPDIR=str(tmp_path),
                        PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}")
+    environment.pop("STICKSLIP_WORKDIR", None)
     done = subprocess.run([sys.executable, __file__, tmp_path / "results.json"], cwd=directory, env=environment,
                           capture_output=True, text=True, timeout=900)
     assert done.returncode == 0, done.stderr[-3000:]
-    results = {line: (printed, error) for line, printed, error in json.loads((tmp_path / "results.json").read_text())}
+    outcome = json.loads((tmp_path / "results.json").read_text())
+    results = {line: (printed, error) for line, printed, error in outcome["blocks"]}
     blocks = tutorial_blocks(TUTORIAL.read_text(encoding="utf-8"))
     for language, _, line, shown in blocks:
         assert line in results, f"{TUTORIAL.name}: the block at line {line} did not run"
@@ -90,9 +103,12 @@ def test_every_block_of_the_tutorial_runs_and_prints_what_it_shows(ci_study, tmp
         assert error is None, f"{TUTORIAL.name}, block at line {line}:\n{error}"
         if shown is not None:
             assert _lines(printed) == _lines(shown), f"{TUTORIAL.name}, block at line {line}"
-    assert (directory / "tutorial.png").stat().st_size > 10_000
+    work = Path(outcome["work"])
+    assert work.parent == tmp_path and (work / "tutorial.png").stat().st_size > 10_000
+    assert _files(directory) == before  # nothing written into the repository
 
 
 if __name__ == "__main__":  # the fresh process of the test above: python test_tutorial.py RESULTS.json
-    outcome = list(run_blocks(tutorial_blocks(TUTORIAL.read_text(encoding="utf-8"))))
-    Path(sys.argv[1]).write_text(json.dumps(outcome))
+    namespace = {"__name__": "__tutorial__"}
+    outcome = list(run_blocks(tutorial_blocks(TUTORIAL.read_text(encoding="utf-8")), namespace))
+    Path(sys.argv[1]).write_text(json.dumps({"blocks": outcome, "work": str(namespace.get("work"))}))

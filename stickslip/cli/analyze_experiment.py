@@ -58,7 +58,7 @@ def run(args):
     for path in iterate(args.runs, desc="analyze-experiment", unit="run"):
         record = read_timeseries(path)
         slips, _ = analyse_record(record, params)
-        tables.append(slips.assign(run=str(path)))
+        tables.append(slips.assign(path=str(path)))
         missing = missing_drop_error(record, slips, str(path))
         if missing:
             raise ParameterError(missing)

@@ -3,9 +3,12 @@
 Sub-commands: ``runs`` and ``events`` (filters, ``--format table|csv|json``),
 ``sql "SELECT ..."`` (read-only connection; Ctrl-C stops it at once; time, rows and memory bounded by
 default, ``--time-limit``, ``--max-rows``, ``--memory-limit``), ``ingest RECORD...`` (add records),
-``rebuild`` (recreate the database from the records under the results directory).
-Each study has its own database, ``results/{study}/stickslip.sqlite``: ``--study NAME``
-chooses it (default: ``default``), ``--db FILE`` names any file.
+``rebuild`` (recreate the database from the records under the results directory), ``migrate`` (bring a
+database of an older schema to this one, keeping its rows).
+Each study has its own database, ``results/{study}/stickslip.sqlite`` in the workflow directory (found from
+any folder below it, :mod:`stickslip.workdir`): ``--study NAME`` chooses it (default: ``default``),
+``--workdir DIR`` the workflow directory, ``--db FILE`` names any file. The filters of ``runs`` and ``events``
+are those of ``stickslip.study(...).runs/events`` (:mod:`stickslip.provenance.filters`).
 """
 
 import os
@@ -14,29 +17,88 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..formats.fem_run import REGIMES
 from ..h5io import FileFormatError
+from ..params import ParameterError, parse_assignments
+from ..provenance.filters import EVENT_FILTERS, RUN_FILTERS
 from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
+from ..workdir import ENVIRONMENT, find_workdir
 
 FORMATS = ("table", "csv", "json")
 
+#: What ``stickslip db --help`` says.
+DESCRIPTION = ("Query and (re)build the results database of a study: results/STUDY/stickslip.sqlite in the "
+               "workflow directory (the nearest folder with a Snakefile at or above the current one, or "
+               f"--workdir, or ${ENVIRONMENT}).")
+
 #: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
-RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "a", "blocks", "phi", "regime",
-               "temperature", "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
+RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "driven_slab", "blocks", "phi",
+               "regime", "temperature", "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
 
 EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",
-                 "interface", "slip", "dmu", "multi", "time", "increment")
+                 "interface", "slip", "dmu", "dmu_sig0", "multi", "time", "t", "increment")
 
 
 def _database_options(parser):
     parser.add_argument("--study", default="default",
-                        help="study whose database to use: results/STUDY/stickslip.sqlite (default: default)")
+                        help="study whose database to use: results/STUDY/stickslip.sqlite in the workflow directory "
+                             "(default: default)")
+    parser.add_argument("--workdir", type=Path, default=None, metavar="DIR",
+                        help=f"the workflow directory (default: ${ENVIRONMENT}, else the nearest folder at or above "
+                             "the current one with a Snakefile)")
     parser.add_argument("--db", type=Path, default=None, help="database file (overrides --study)")
 
 
-def _database(args):
-    """The database file of the arguments: ``--db``, else the study's."""
-    return args.db or Path("results") / args.study / "stickslip.sqlite"
+def _results(args):
+    """The results tree of ``--study`` in the workflow directory."""
+    return find_workdir(args.workdir).path / "results" / args.study
+
+
+def _database(args, *, exists=True):
+    """The database file of the arguments: ``--db``, else the study's (one line if ``exists`` and there is none)."""
+    if args.db is not None:
+        return args.db
+    database = _results(args) / "stickslip.sqlite"
+    if exists and not database.is_file():
+        raise FileFormatError(f"{database}: no database of study {args.study!r} (run `snakemake --cores 2` with its "
+                              f"config there); the workflow directory is {find_workdir(args.workdir)} (another: "
+                              f"--workdir or ${ENVIRONMENT})")
+    return database
+
+
+_CONVERT = {"int": int, "float": float, "str": str}
+
+
+def _bool(text):
+    """``--multi`` values: true/false (as the ``--param`` values of a bool)."""
+    value = text.strip().lower()
+    if value not in ("true", "false", "yes", "no", "1", "0"):
+        raise ValueError(text)
+    return value in ("true", "yes", "1")
+
+
+_bool.__name__ = "true or false"  # argparse's message: "invalid true or false value: 'x'"
+
+
+def _filter_options(parser, specs):
+    """One option per filter (``--k-drive``), with the filter's type, choices and help; ``--param NAME=VALUE``."""
+    for spec in specs:
+        choices = spec.choices if isinstance(spec.choices, tuple) else None
+        metavar = None if choices else "true|false" if spec.kind == "bool" else spec.name.upper()
+        parser.add_argument(f"--{spec.name.replace('_', '-')}", dest=spec.name, type=_CONVERT.get(spec.kind, _bool),
+                            choices=choices, metavar=metavar, help=spec.doc)
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a parameter of a plugin (repeatable), e.g. --param backend=cpu (stickslip plugins "
+                             "--params)")
+
+
+def _filters(args, specs):
+    """The filter values given on the command line, with the ``--param`` ones."""
+    given = {spec.name: getattr(args, spec.name) for spec in specs}
+    parameters = parse_assignments(args.param)
+    clash = sorted(set(parameters) & set(given))
+    if clash:
+        raise ParameterError(f"--param {clash[0]}: a column; use --{clash[0].replace('_', '-')}")
+    return {**given, **parameters}
 
 
 def _common(parser, default_format="table"):
@@ -47,8 +109,7 @@ def _common(parser, default_format="table"):
 
 def add_parser(subparsers):
     """Add the ``db`` sub-command and its own sub-commands."""
-    parser = subparsers.add_parser("db", help="query or rebuild the results database",
-                                   description=__doc__.splitlines()[0])
+    parser = subparsers.add_parser("db", help="query or rebuild the results database", description=DESCRIPTION)
     commands = parser.add_subparsers(dest="db_command", required=True, metavar="DB_COMMAND")
 
     def command(name, summary):
@@ -57,24 +118,12 @@ def add_parser(subparsers):
 
     runs = command("runs", "list runs with their parameters")
     _common(runs)
-    runs.add_argument("--kind", choices=("solver", "analysis", "figure", "mesh"))
-    runs.add_argument("--plugin")
-    runs.add_argument("--solver")
-    runs.add_argument("--n", type=int, help="number of driven interfaces")
-    runs.add_argument("--regime", choices=REGIMES)
-    runs.add_argument("--seed", type=int)
+    _filter_options(runs, RUN_FILTERS)
     runs.set_defaults(func=run_runs)
 
     events = command("events", "list slip events with their simulation's parameters")
     _common(events)
-    events.add_argument("--solver")
-    events.add_argument("--analysis")
-    events.add_argument("--source", choices=("numerical", "experimental"))
-    events.add_argument("--n", type=int, help="number of driven interfaces")
-    events.add_argument("--interface", type=int, help="interface (slab) a, 1 = lowest")
-    events.add_argument("--regime", choices=REGIMES)
-    events.add_argument("--seed", type=int)
-    events.add_argument("--run-id", help="one simulation")
+    _filter_options(events, EVENT_FILTERS)
     events.set_defaults(func=run_events)
 
     sql = command("sql", "run SQL on a read-only connection")
@@ -101,6 +150,10 @@ def add_parser(subparsers):
                          help="results tree whose records to read (default results/STUDY)")
     rebuild.set_defaults(func=run_rebuild)
 
+    migrate = command("migrate", "bring a database of an older schema to this one, keeping its rows")
+    _database_options(migrate)
+    migrate.set_defaults(func=run_migrate)
+
 
 def _print(frame, args, columns=None):
     try:
@@ -116,7 +169,7 @@ def _write(frame, args, columns):
     if args.format == "csv":
         frame.to_csv(sys.stdout, index=False)
     elif args.format == "json":
-        sys.stdout.write(frame.to_json(orient="records", indent=1) + "\n")
+        sys.stdout.write(frame.to_json(orient="records", indent=1, date_format="iso") + "\n")
     elif frame.empty:
         print("(no rows)")
     else:
@@ -138,14 +191,12 @@ def _query(args, name, columns=None, *positional, **filters):
 
 def run_runs(args):
     """``db runs``."""
-    return _query(args, "runs", RUN_COLUMNS, kind=args.kind, plugin=args.plugin, solver=args.solver, n=args.n,
-                  regime=args.regime, seed=args.seed)
+    return _query(args, "runs", RUN_COLUMNS, **_filters(args, RUN_FILTERS))
 
 
 def run_events(args):
     """``db events``."""
-    return _query(args, "events", EVENT_COLUMNS, solver=args.solver, analysis=args.analysis, source=args.source,
-                  n=args.n, interface=args.interface, regime=args.regime, seed=args.seed, run_id=args.run_id)
+    return _query(args, "events", EVENT_COLUMNS, **_filters(args, EVENT_FILTERS))
 
 
 def run_sql(args):
@@ -158,7 +209,7 @@ def run_ingest(args):
     """``db ingest``."""
     from ..provenance.ingest import ingest
 
-    counts = ingest(_database(args), args.records)
+    counts = ingest(_database(args, exists=False), args.records)
     print(", ".join(f"{count} {name}" for name, count in counts.items()) + " ingested")
     return 0
 
@@ -167,11 +218,21 @@ def run_rebuild(args):
     """``db rebuild``."""
     from ..provenance.ingest import find_records, ingest
 
-    results = args.results or Path("results") / args.study
+    results = args.results or _results(args)
     records = find_records(results)
     if not records:
         raise FileFormatError(f"{results}: no provenance records (*.provenance.json) found")
     database = args.db or results / "stickslip.sqlite"
     counts = ingest(database, records, rebuild=True)
     print(f"{database}: rebuilt from " + ", ".join(f"{count} {name}" for name, count in counts.items()))
+    return 0
+
+
+def run_migrate(args):
+    """``db migrate``."""
+    from ..provenance.migrate import migrate
+
+    database = _database(args)
+    before, after = migrate(database)
+    print(f"{database}: schema {before}" + (f" migrated to {after}" if before != after else ", nothing to migrate"))
     return 0

@@ -181,7 +181,7 @@ def rate_slope(runs):
     """
     rows = []
     for rate, group in runs.groupby("drive_rate"):
-        peaks = np.concatenate([item.tables["slip_events"]["mu_before"].to_numpy(dtype=float)
+        peaks = np.concatenate([item.tables["slip_events"]["mu_before_sig0"].to_numpy(dtype=float)
                                 for item in group["data"]])
         mean, sem, count = mean_sem(peaks)
         rows.append({"drive_rate": rate, "peak": mean, "sem": sem, "slips": count})
@@ -199,14 +199,22 @@ def rate_slope(runs):
 def estimator(slips, T0, fit):
     """The paper's aging fit of Delta mu against the waiting time of single slips (``fit``: "origin" or "intercept").
 
+    Parameters
+    ----------
+    slips : pandas.DataFrame
+        A ``thermal-events`` slip table: ``multi``, ``T_fe`` [time], ``dmu_sig0`` [sig0].
+    T0 : float
+        The time scale of the fit [time].
+    fit : {"origin", "intercept"}
+
     Returns
     -------
     dict
         ``B``, ``B_error``, ``c``, ``c_error`` [sig0], ``slips``, ``bins``; NaN where the fit cannot be made.
     """
-    single = slips[~slips["multi"].astype(bool) & np.isfinite(slips["T"])]
+    single = slips[~slips["multi"].astype(bool) & np.isfinite(slips["T_fe"])]
     try:
-        result = fit_aging(single["T"].to_numpy(), single["dmu"].to_numpy(), t0=T0, fit=fit)
+        result = fit_aging(single["T_fe"].to_numpy(), single["dmu_sig0"].to_numpy(), t0=T0, fit=fit)
     except ValueError:
         return {"B": math.nan, "B_error": math.nan, "c": math.nan, "c_error": math.nan, "slips": len(single),
                 "bins": 0}

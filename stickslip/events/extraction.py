@@ -185,7 +185,7 @@ def steady_slips(classified, N):
     -------
     pandas.DataFrame
         Columns ``increment``, ``gamma`` [gamma0], ``s`` (number of slipping interfaces),
-        ``interfaces`` (e.g. "1,3"), ``single`` (bool: s == 1), ``sigma_before``,
+        ``interfaces`` (e.g. "1,3"), ``multi`` (bool: s > 1), ``sigma_before``,
         ``sigma_after`` (macroscopic stress Sigma before the kick and after minimisation
         [sig0]) and ``dsigma`` (their difference [sig0]).
     """
@@ -200,7 +200,7 @@ def steady_slips(classified, N):
         "gamma": classified["gamma"].to_numpy(dtype=float)[rows],
         "s": classified["s"].to_numpy()[rows],
         "interfaces": np.asarray(names, dtype=object),
-        "single": classified["s"].to_numpy()[rows] == 1,
+        "multi": classified["s"].to_numpy()[rows] > 1,
         "sigma_before": before,
         "sigma_after": sigd[rows],
         "dsigma": before - sigd[rows],
@@ -220,27 +220,27 @@ def slip_interfaces(classified, N):
     Returns
     -------
     pandas.DataFrame
-        Columns ``increment``, ``a`` (interface), ``dmu`` (stress drop of interface a: its
+        Columns ``increment``, ``interface`` (a), ``dmu_sig0`` (stress drop of interface a: its
         volume-averaged equivalent stress before the kick minus after minimisation [sig0]),
         ``dgamma`` (lever rotation since the previous steady-state slip involving interface a
-        [gamma0]; NaN for the first) and ``single`` (bool: the event is a single slip).
-        Sorted by increment, then a.
+        [gamma0]; NaN for the first) and ``multi`` (bool: more than one interface slipped in the event).
+        Sorted by increment, then interface.
     """
     interfaces = interfaces_in(classified)
     steady_slips = _slip_rows(classified)
     gamma = classified["gamma"].to_numpy(dtype=float)
     increment = classified["increment"].to_numpy()
-    single = classified["s"].to_numpy() == 1
+    multi = classified["s"].to_numpy() > 1
     parts = []
     for a in interfaces:
         rows = np.flatnonzero(steady_slips & (classified[f"A_a{a}"].to_numpy() == N))
         mu = classified[f"mu_a{a}"].to_numpy(dtype=float)
         dgamma = np.full(rows.size, np.nan)
         dgamma[1:] = np.diff(gamma[rows])
-        parts.append(pd.DataFrame({"increment": increment[rows], "a": np.full(rows.size, a, dtype=np.int64),
-                                   "dmu": mu[rows - 1] - mu[rows], "dgamma": dgamma, "single": single[rows]}))
+        parts.append(pd.DataFrame({"increment": increment[rows], "interface": np.full(rows.size, a, dtype=np.int64),
+                                   "dmu_sig0": mu[rows - 1] - mu[rows], "dgamma": dgamma, "multi": multi[rows]}))
     table = pd.concat(parts, ignore_index=True)
-    return table.sort_values(["increment", "a"], kind="stable").reset_index(drop=True)
+    return table.sort_values(["increment", "interface"], kind="stable").reset_index(drop=True)
 
 
 def slip_fractions(slips, n):
@@ -272,7 +272,7 @@ def slip_sequences(slips):
     Parameters
     ----------
     slips : pandas.DataFrame
-        Slip events of one simulation in order (columns ``increment``, ``single``).
+        Slip events of one simulation in order (columns ``increment``, ``multi``).
 
     Returns
     -------
@@ -280,7 +280,7 @@ def slip_sequences(slips):
         One row per run: ``first_increment``, ``last_increment``, ``kind`` ("single" or
         "multi") and ``length`` (number of slip events). A run of length >= 2 is a sequence.
     """
-    single = slips["single"].to_numpy(dtype=bool)
+    single = ~slips["multi"].to_numpy(dtype=bool)
     increment = slips["increment"].to_numpy()
     starts = np.flatnonzero(np.r_[True, single[1:] != single[:-1]])[:single.size]
     ends = np.r_[starts[1:], single.size][:starts.size] - 1

@@ -134,14 +134,14 @@ def periodicity(slips, n):
     Returns
     -------
     dict[str, float]
-        :data:`COLUMNS`: ``slips`` (m), ``multi`` (s > 1) and ``spanning`` (s = n) counts, then
+        :data:`COLUMNS`: the counts ``n_slips`` (m), ``n_multi`` (s > 1) and ``n_spanning`` (s = n), then
         :data:`MEASURES`.
     """
     s = slips["s"].to_numpy(dtype=np.int64)
     m = s.size
     multi = s > 1
     spanning = s == n
-    return {"slips": m, "multi": int(multi.sum()), "spanning": int(spanning.sum()),
+    return {"n_slips": m, "n_multi": int(multi.sum()), "n_spanning": int(spanning.sum()),
             "interval_cv": coefficient_of_variation(np.diff(slips["gamma"].to_numpy(dtype=float)))
             if m >= 3 else math.nan,
             "drop_cv": coefficient_of_variation(slips["dsigma"].to_numpy(dtype=float)),
@@ -181,14 +181,14 @@ def seed_summary(rows, keys):
     Returns
     -------
     pandas.DataFrame
-        Per parameter set: ``keys``, ``runs`` (runs pooled), ``slips`` (total), then per measure
+        Per parameter set: ``keys``, ``runs`` (runs pooled), ``n_slips`` (total), then per measure
         ``<measure>`` (mean over the runs where it is defined), ``<measure>_error`` (standard error
         over them, NaN from fewer than two) and ``<measure>_runs`` (how many runs define it).
     """
     out = []
     for values, group in rows.groupby(list(keys), sort=True):
         values = values if isinstance(values, tuple) else (values,)
-        row = dict(zip(keys, values), runs=len(group), slips=int(group["slips"].sum()))
+        row = dict(zip(keys, values), runs=len(group), n_slips=int(group["n_slips"].sum()))
         for measure in MEASURES:
             x = group[measure].to_numpy(dtype=float)
             x = x[np.isfinite(x)]

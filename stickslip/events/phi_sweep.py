@@ -44,7 +44,7 @@ def _point(n, phi, files):
     m = len(slips)
     k = int((slips["s"] > 1).sum()) if m else 0
     low, high = wilson_interval(k, m)
-    dmu = per["dmu"].to_numpy(dtype=float) if len(per) else np.empty(0)
+    dmu = per["dmu_sig0"].to_numpy(dtype=float) if len(per) else np.empty(0)
     count = dmu.size
     std = float(np.std(dmu, ddof=1)) if count > 1 else math.nan
     return {"n": n, "phi": phi, "N": ",".join(str(v) for v in sorted({int(f.attrs["N"]) for f in files})),

@@ -5,7 +5,7 @@ tables as in :func:`stickslip.h5io.write_table`):
 
 ``slip_events``
     the normalised slip table that the database ingests (:mod:`stickslip.formats.event_table`):
-    ``event`` (index of the steady-state slip event), ``interface``, ``multi``, ``dmu``, ``increment``;
+    ``event`` (index of the steady-state slip event), ``interface``, ``multi``, ``dmu_sig0``, ``increment``;
 ``increments``
     every stored increment, classified (:func:`~stickslip.events.extraction.classify_increments`);
 ``slips``
@@ -38,7 +38,7 @@ from . import extraction, periodicity
 __all__ = ["EventParams", "NAME", "VERSION", "event_tables", "numerical_slip_events", "event_attrs", "write_event_file", "run"]
 
 NAME = "numerical-events"
-VERSION = "2"  # 2: the table "periodicity"
+VERSION = "3"  # 2: the table "periodicity"; 3: the package's vocabulary (interface, multi, dmu_sig0, n_slips, ...)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -89,13 +89,13 @@ def numerical_slip_events(per_interface):
     -------
     pandas.DataFrame
         ``event`` (steady-state slip events numbered from 0 in increment order), ``interface``,
-        ``multi``, ``dmu`` [sig0], ``increment``, then ``dgamma`` [gamma0].
+        ``multi``, ``dmu_sig0`` [sig0], ``increment``, then ``dgamma`` [gamma0].
     """
     increment = per_interface["increment"].to_numpy()
     return slip_events_table(pd.DataFrame({
-        "event": np.unique(increment, return_inverse=True)[1].reshape(-1), "interface": per_interface["a"],
-        "multi": ~per_interface["single"].to_numpy(dtype=bool), "dmu": per_interface["dmu"],
-        "increment": increment, "dgamma": per_interface["dgamma"]}))
+        "event": np.unique(increment, return_inverse=True)[1].reshape(-1), "interface": per_interface["interface"],
+        "multi": per_interface["multi"], "dmu_sig0": per_interface["dmu_sig0"], "increment": increment,
+        "dgamma": per_interface["dgamma"]}))
 
 
 def event_attrs(run_attrs, classified, *, source="run"):

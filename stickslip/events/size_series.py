@@ -94,7 +94,7 @@ def drop_shift_by_size(files, reference=1):
         if key["regime"] != "compliant":
             continue
         per = item.tables["slip_interfaces"]
-        drops = per["dmu"].to_numpy(dtype=float)[per["single"].to_numpy(dtype=bool)]
+        drops = per["dmu_sig0"].to_numpy(dtype=float)[~per["multi"].to_numpy(dtype=bool)]
         group = (key["N"], key["dt_scale"], key["n"])
         pooled.setdefault(group, []).append(drops)
         if drops.size:

@@ -5,10 +5,12 @@ on a ``fem`` run with a clock (a thermal run, ``temperature > 0``), plus the sli
 experiment done on its stored states:
 
 - **slips**: every steady-state slip of an interface (:func:`.extraction.slip_interfaces`) with
-  ``time`` (the run's clock ``t``), ``T`` (time since the previous slip of the same interface, any
-  slip of it counted, also before the steady state), ``hold`` (time of ``T`` during which the drive
-  was held), ``mu_before`` (the interface's stress before the slip, its peak [sig0]) and the aging
-  rate of the slip ``B_a = dmu / ln(T / T0)`` with the microscopic time ``T0 = 1 / attempt_rate``;
+  ``t`` (the run's clock), ``T_fe`` (time since the previous slip of the same interface, any
+  slip of it counted, also before the steady state), ``hold`` (time of ``T_fe`` during which the drive
+  was held), ``mu_before_sig0`` (the interface's stress before the slip, its peak [sig0]) and the aging
+  rate of the slip ``B_a_sig0 = dmu_sig0 / ln(T_fe / T0)`` [sig0] with the microscopic time
+  ``T0 = 1 / attempt_rate`` (the model's counterparts of the lab's ``time``, ``T``, ``mu_before``, ``B_a``:
+  :mod:`stickslip.vocabulary`);
   for an athermal run, whose ``t`` counts minimisation time steps, not time, these are NaN;
 - **slow slip** per interface over the steady state: the interface's plastic slip ``R_a`` counted in
   well hops (the signed hops ``S_a`` of its blocks, Gauss point 0, summed over the increments; the
@@ -28,8 +30,8 @@ experiment done on its stored states:
   ``aftershock_states`` slips of every interface with their controls (``aftershock_trials``,
   ``aftershocks``).
 
-Output (format ``event-table``): ``slip_events`` (the normalised table; further columns ``T``,
-``hold``, ``B_a``, ``mu_before``, ``dgamma``), ``interfaces`` (``a``, ``R_tot``, ``dR_sum`` [well hops],
+Output (format ``event-table``): ``slip_events`` (the normalised table; further columns ``T_fe``,
+``hold``, ``B_a_sig0``, ``mu_before_sig0``, ``dgamma``), ``interfaces`` (``interface``, ``R_tot``, ``dR_sum`` [well hops],
 ``R_slow``, ``n_slips``), ``holds`` (one row per trial: ``trial``, ``state`` (increment), ``replica``,
 ``hold_time``, ``peak``, ``interface``, ``mu_start`` [sig0], ``failed_in_hold``, ``t_slip``,
 ``hold_hops``, ``events``), ``creep`` (``trial``, ``t`` since the hold's start, ``R_<a>`` the slip of
@@ -59,7 +61,7 @@ from .plugin import event_attrs
 __all__ = ["ThermalEventParams", "NAME", "VERSION", "slip_table", "interface_table", "hold_tables", "run"]
 
 NAME = "thermal-events"
-VERSION = "1"
+VERSION = "2"  # 2: the package's vocabulary (dmu_sig0, t, T_fe, B_a_sig0, mu_before_sig0, interface; event-table 2)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -107,8 +109,8 @@ def slip_table(increments, classified, N, *, T0=None):
     Returns
     -------
     pandas.DataFrame
-        :func:`stickslip.formats.event_table.slip_events_table` with ``time``, ``T``, ``hold``, ``B_a``,
-        ``mu_before``, ``dgamma``.
+        :func:`stickslip.formats.event_table.slip_events_table` with ``t``, ``T_fe``, ``hold``, ``B_a_sig0``,
+        ``mu_before_sig0``, ``dgamma``.
     """
     per_interface = extraction.slip_interfaces(classified, N)
     increment = classified["increment"].to_numpy()
@@ -117,8 +119,8 @@ def slip_table(increments, classified, N, *, T0=None):
     position = {inc: i for i, inc in enumerate(increment)}
     rows = np.array([position[inc] for inc in per_interface["increment"]], dtype=np.int64)
     waits, holds, before = np.full(rows.size, np.nan), np.full(rows.size, np.nan), np.empty(rows.size)
-    for a in np.unique(per_interface["a"]):
-        mine = np.flatnonzero(per_interface["a"].to_numpy() == a)
+    for a in np.unique(per_interface["interface"]):
+        mine = np.flatnonzero(per_interface["interface"].to_numpy() == a)
         slips = _slip_rows(classified, N, a)
         previous = slips[np.searchsorted(slips, rows[mine]) - 1]
         first = np.searchsorted(slips, rows[mine]) == 0
@@ -129,10 +131,10 @@ def slip_table(increments, classified, N, *, T0=None):
     time = t[rows] if T0 is not None else np.full(rows.size, np.nan)
     return slip_events_table(pd.DataFrame({
         "event": np.unique(per_interface["increment"].to_numpy(), return_inverse=True)[1].reshape(-1),
-        "interface": per_interface["a"], "multi": ~per_interface["single"].to_numpy(dtype=bool),
-        "dmu": per_interface["dmu"], "time": time, "increment": per_interface["increment"],
-        "T": waits, "hold": holds, "B_a": aging_rate(per_interface["dmu"], waits, t0=T0 or 1.0),
-        "mu_before": before, "dgamma": per_interface["dgamma"]}))
+        "interface": per_interface["interface"], "multi": per_interface["multi"],
+        "dmu_sig0": per_interface["dmu_sig0"], "t": time, "increment": per_interface["increment"],
+        "T_fe": waits, "hold": holds, "B_a_sig0": aging_rate(per_interface["dmu_sig0"], waits, t0=T0 or 1.0),
+        "mu_before_sig0": before, "dgamma": per_interface["dgamma"]}))
 
 
 def interface_table(classified, N):
@@ -141,7 +143,7 @@ def interface_table(classified, N):
     Returns
     -------
     pandas.DataFrame
-        ``a``, ``R_tot``, ``dR_sum`` [well hops], ``R_slow``, ``n_slips``; no rows without a steady state.
+        ``interface``, ``R_tot``, ``dR_sum`` [well hops], ``R_slow``, ``n_slips``; no rows without a steady state.
     """
     steady = np.flatnonzero(classified["steady"].to_numpy(dtype=bool))
     rows = []
@@ -153,9 +155,10 @@ def interface_table(classified, N):
         slips = slips[slips > steady[0]]
         R_tot = float(np.sum(hops[steady[0] + 1:]))
         dR_sum = float(np.sum(hops[slips]))
-        rows.append({"a": a, "R_tot": R_tot, "dR_sum": dR_sum, "R_slow": float(slow_slip_fraction(R_tot, dR_sum)),
+        rows.append({"interface": a, "R_tot": R_tot, "dR_sum": dR_sum,
+                     "R_slow": float(slow_slip_fraction(R_tot, dR_sum)),
                      "n_slips": slips.size})
-    return pd.DataFrame(rows, columns=["a", "R_tot", "dR_sum", "R_slow", "n_slips"])
+    return pd.DataFrame(rows, columns=["interface", "R_tot", "dR_sum", "R_slow", "n_slips"])
 
 
 def hold_tables(hold, states, params, T0, n_interfaces, results=None):

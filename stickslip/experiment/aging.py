@@ -169,7 +169,7 @@ def fit_aging_per_interface(slips, *, t0=T0, fit="origin", bins_per_decade=4, mi
     Parameters
     ----------
     slips : pandas.DataFrame
-        Columns ``a``, ``T`` [s], ``dmu`` (rows with NaN are ignored).
+        Columns ``interface``, ``T`` [s], ``dmu`` (rows with NaN are ignored).
     t0, fit, bins_per_decade, min_count
         See :func:`fit_aging`.
 
@@ -180,7 +180,7 @@ def fit_aging_per_interface(slips, *, t0=T0, fit="origin", bins_per_decade=4, mi
         (too few bins).
     """
     results = {}
-    for a, part in slips.groupby("a", sort=True):
+    for a, part in slips.groupby("interface", sort=True):
         try:
             results[int(a)] = fit_aging(part["T"], part["dmu"], t0=t0, fit=fit, bins_per_decade=bins_per_decade,
                                         min_count=min_count)
@@ -198,7 +198,7 @@ def fit_single_slips(slips, *, t0=T0, fit="origin", per_interface=False):
     Parameters
     ----------
     slips : pandas.DataFrame
-        One row per slip (:func:`stickslip.experiment.analysis.analyse_record`): columns ``a``,
+        One row per slip (:func:`stickslip.experiment.analysis.analyse_record`): columns ``interface``,
         ``multi``, ``T`` [s], ``dmu``; the slips of one or several recordings.
     t0, fit
         See :func:`fit_aging`.
@@ -247,12 +247,12 @@ def aging_rate(dmu, T, *, t0=T0):
 def _spread(valid):
     individual = valid[valid["protocol"] == "individual"].assign(n=1)
     stack = valid[valid["protocol"] == "stack"]
-    has_individual = set(individual["a"].unique())
-    stack = stack[~((stack["n"] == 1) & stack["a"].isin(has_individual))]
-    table = (pd.concat([individual, stack]).groupby(["a", "n"])["B_a"]
+    has_individual = set(individual["interface"].unique())
+    stack = stack[~((stack["n"] == 1) & stack["interface"].isin(has_individual))]
+    table = (pd.concat([individual, stack]).groupby(["interface", "n"])["B_a"]
              .agg(std=lambda b: b.std(ddof=1), count="size").reset_index())
-    reference = table[table["n"] == 1].set_index("a")["std"]
-    table["std_normalised"] = table["std"] / table["a"].map(reference)
+    reference = table[table["n"] == 1].set_index("interface")["std"]
+    table["std_normalised"] = table["std"] / table["interface"].map(reference)
     return table
 
 
@@ -270,12 +270,12 @@ def spread_of_aging_rate(slips):
     Parameters
     ----------
     slips : pandas.DataFrame
-        Columns ``a``, ``n``, ``protocol``, ``B_a`` (NaN entries are ignored), optionally ``seed``.
+        Columns ``interface``, ``n``, ``protocol``, ``B_a`` (NaN entries are ignored), optionally ``seed``.
 
     Returns
     -------
     pandas.DataFrame
-        Columns ``a``, ``n``, ``std`` (of ``B_a``), ``count``, ``std_normalised``
+        Columns ``interface``, ``n``, ``std`` (of ``B_a``), ``count``, ``std_normalised``
         (``std / std`` of the reference; NaN without reference), ``std_normalised_error`` (NaN
         without seeds). The reference rows have ``n = 1``.
     """
@@ -284,7 +284,7 @@ def spread_of_aging_rate(slips):
     table["std_normalised_error"] = np.nan
     seeds = sorted(valid["seed"].dropna().unique()) if "seed" in valid.columns else []
     if len(seeds) >= 3:
-        key = ["a", "n"]
+        key = ["interface", "n"]
         left_out = pd.concat([_spread(valid[valid["seed"] != seed]).assign(left_out=seed) for seed in seeds])
         spread = left_out.groupby(key)["std_normalised"].agg(
             lambda r: np.sqrt((len(seeds) - 1) / len(seeds) * np.sum((r - r.mean()) ** 2)) if len(r) == len(seeds)

@@ -7,9 +7,9 @@ tables (:func:`stickslip.h5io.write_table`) and the run's attributes copied to t
 
 ``slip_events``: the normalised slip table that the database ingests
 (:mod:`stickslip.formats.event_table`): ``event``, ``interface``, ``multi``, ``slip`` (dR),
-``dmu``, ``time`` (t).
+``dmu``, ``time``.
 ``slips``: one row per slip of one interface, sorted by time (see :func:`analyse_record`).
-``interfaces``: one row per interface ``a``: ``driven`` (it can slip: ``a <= n`` in the stack,
+``interfaces``: one row per ``interface`` a: ``driven`` (it can slip: ``a <= n`` in the stack,
 ``a`` the driven slab in the individual protocol), ``R_tot`` [mm] (total sliding over the analysed
 record), ``dR_sum`` [mm] (sum of its detected slips), ``R_slow`` (``1 - dR_sum / R_tot``),
 ``n_slips``, ``n_multi``.
@@ -34,10 +34,13 @@ from .timeseries import read_timeseries
 __all__ = ["ExperimentEventsParams", "analyse_record", "experimental_slip_events", "run", "NAME", "VERSION"]
 
 NAME = "experiment-events"
-VERSION = "2"
+VERSION = "3"  # 3: the package's vocabulary (interface, time, slip, slip_from_dF; event-table 2)
 
-SLIP_COLUMNS = ["event", "t", "a", "n", "protocol", "multi", "t_start", "t_end", "dF", "dmu", "T", "dR",
-                "dR_from_dF", "B_a", "drift", "slow_slip_before"]
+SLIP_COLUMNS = ["event", "time", "interface", "n", "protocol", "multi", "t_start", "t_end", "dF", "dmu", "T", "slip",
+                "slip_from_dF", "B_a", "drift", "slow_slip_before"]
+
+#: The names of :func:`stickslip.experiment.detection.detect_slips` and of the paper in the vocabulary's words.
+_VOCABULARY = {"a": "interface", "t": "time", "dR": "slip", "dR_from_dF": "slip_from_dF"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -87,19 +90,19 @@ def analyse_record(record, params=ExperimentEventsParams()):
     -------
     slips : pandas.DataFrame
         One row per slip of one interface, columns :data:`SLIP_COLUMNS`:
-        ``event`` (slips with overlapping brackets share it), ``t`` [s] (time of the slip),
-        ``a`` (interface, 1 = lowest), ``n``, ``protocol``, ``multi`` (bool: more than one interface
-        slipped in the event; ``dmu``, ``dR_from_dF``, ``B_a`` are then NaN since the lever
+        ``event`` (slips with overlapping brackets share it), ``time`` [s] (time of the slip),
+        ``interface`` (a, 1 = lowest), ``n``, ``protocol``, ``multi`` (bool: more than one interface
+        slipped in the event; ``dmu``, ``slip_from_dF``, ``B_a`` are then NaN since the lever
         kinematics of a single slip does not apply), ``t_start``, ``t_end`` [s] (frames that
         bracket the slip), ``dF`` [N] (force drop of the event), ``dmu`` [-]
         (:func:`~stickslip.experiment.kinematics.dmu_from_dF`), ``T`` [s] (since the previous slip
-        of interface ``a``; NaN for its first), ``dR`` [mm] (measured, see
-        :func:`~stickslip.experiment.detection.detect_slips`), ``dR_from_dF`` [mm]
+        of interface ``a``; NaN for its first), ``slip`` [mm] (dR, measured, see
+        :func:`~stickslip.experiment.detection.detect_slips`), ``slip_from_dF`` [mm]
         (:func:`~stickslip.experiment.kinematics.dR_from_dF`), ``B_a``
         (``dmu / ln(T / T0)``), ``drift`` [mm] (``R_a`` just before the slip minus ``R_a`` just
         after the previous slip of ``a``, both averaged over ``position_frames`` frames), ``slow_slip_before`` (``drift >= slow_slip_drift``).
     interfaces : pandas.DataFrame
-        Columns ``a``, ``driven``, ``R_tot``, ``dR_sum`` [mm], ``R_slow`` [-], ``n_slips``, ``n_multi``.
+        Columns ``interface``, ``driven``, ``R_tot``, ``dR_sum`` [mm], ``R_slow`` [-], ``n_slips``, ``n_multi``.
     """
     R = record.R
     slips = detection.detect_slips(record.t_x, R, threshold=params.threshold, width=params.average_frames,
@@ -128,17 +131,17 @@ def analyse_record(record, params=ExperimentEventsParams()):
     first_frame = int(np.searchsorted(record.t_x, record.t_x[0] + params.t_exclude, side="left"))
     first_frame = min(first_frame, len(record.t_x) - 1)
     slips = slips[slips["i_start"].to_numpy() >= first_frame].sort_values(["t", "a"], kind="stable")
-    slips = slips[SLIP_COLUMNS].reset_index(drop=True)
+    slips = slips.rename(columns=_VOCABULARY)[SLIP_COLUMNS].reset_index(drop=True)
 
     index = np.arange(1, R.shape[1] + 1)
     driven = index <= record.n if record.protocol == "stack" else index == record.a
-    interfaces = pd.DataFrame({"a": index, "driven": driven})
+    interfaces = pd.DataFrame({"interface": index, "driven": driven})
     interfaces["R_tot"] = R[-1] - R[first_frame]
-    grouped = slips.groupby("a")
-    interfaces["dR_sum"] = interfaces["a"].map(grouped["dR"].sum()).fillna(0.0)
+    grouped = slips.groupby("interface")
+    interfaces["dR_sum"] = interfaces["interface"].map(grouped["slip"].sum()).fillna(0.0)
     interfaces["R_slow"] = aging.slow_slip_fraction(interfaces["R_tot"], interfaces["dR_sum"])
-    interfaces["n_slips"] = interfaces["a"].map(grouped.size()).fillna(0).astype(int)
-    interfaces["n_multi"] = interfaces["a"].map(grouped["multi"].sum()).fillna(0).astype(int)
+    interfaces["n_slips"] = interfaces["interface"].map(grouped.size()).fillna(0).astype(np.int64)
+    interfaces["n_multi"] = interfaces["interface"].map(grouped["multi"].sum()).fillna(0).astype(np.int64)
     return slips, interfaces
 
 
@@ -148,12 +151,10 @@ def experimental_slip_events(slips):
     Returns
     -------
     pandas.DataFrame
-        ``event``, ``interface`` (a), ``multi``, ``slip`` (dR) [mm], ``dmu`` [-], ``time`` (t) [s], then
-        the other numeric columns of ``slips`` (``dF``, ``T``, ``B_a``, ``dR_from_dF``, ``drift``, ...).
+        ``event``, ``interface`` (a), ``multi``, ``slip`` (dR) [mm], ``dmu`` [-], ``time`` [s], then
+        the other numeric columns of ``slips`` (``dF``, ``T``, ``B_a``, ``slip_from_dF``, ``drift``, ...).
     """
-    standard = {"event": "event", "a": "interface", "multi": "multi", "dR": "slip", "dmu": "dmu", "t": "time"}
-    further = [c for c in slips.columns if c not in standard and slips[c].dtype.kind in "biuf" and c != "n"]
-    return slip_events_table(pd.concat([slips[list(standard)].rename(columns=standard), slips[further]], axis=1))
+    return slip_events_table(slips[[c for c in slips.columns if slips[c].dtype.kind in "biuf" and c != "n"]])
 
 
 @registry.register("analysis", NAME, VERSION, ExperimentEventsParams, consumes=("timeseries",),

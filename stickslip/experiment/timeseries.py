@@ -347,12 +347,13 @@ def describe(path):
     Returns
     -------
     dict[str, object]
-        ``protocol``, ``n`` (driven slabs), ``a`` (slab driven alone, 0 for the stack) and
-        ``seed`` (None for lab data, which has no seed attribute).
+        ``protocol``, ``n`` (driven slabs), ``driven_slab`` (the attribute ``a``: the slab driven alone, 0 for
+        the stack) and ``seed`` (None for lab data, which has no seed attribute).
     """
     with h5io.open_file(path) as f:
         formats.check(f, FORMAT)
         protocol = f.attrs["protocol"]
         seed = f.attrs.get("seed")
         return {"protocol": protocol.decode() if isinstance(protocol, bytes) else str(protocol),
-                "n": int(f.attrs["n"]), "a": int(f.attrs.get("a", 0)), "seed": None if seed is None else int(seed)}
+                "n": int(f.attrs["n"]), "driven_slab": int(f.attrs.get("a", 0)),
+                "seed": None if seed is None else int(seed)}

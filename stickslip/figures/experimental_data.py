@@ -55,7 +55,7 @@ def _load(paths, table, shuffled):
                 continue
             data = h5io.read_table(f, table)
         data = data.drop(columns=[c for c in ("n", "protocol") if c in data.columns])
-        frames.append(data.assign(**{("a_driven" if k == "a" else k): v for k, v in attrs.items()}))
+        frames.append(data.assign(**{("driven_slab" if k == "a" else k): v for k, v in attrs.items()}))
     if not frames:
         raise h5io.FileFormatError(f"no {EVENTS} files given" if not paths else f"only shuffled runs among the "
                                    f"{len(paths)} {EVENTS} files given")
@@ -73,7 +73,7 @@ def load_slips(paths, *, shuffled=False):
     -------
     pandas.DataFrame
         The ``slips`` table of every file (see :func:`stickslip.experiment.analysis.analyse_record`)
-        plus the run's ``n``, ``protocol``, ``a_driven`` (attribute ``a``), ``seed`` (if stored),
+        plus the run's ``n``, ``protocol``, ``driven_slab`` (attribute ``a``), ``seed`` (if stored),
         apparatus constants ``normal_force`` [N], ``k_spring`` [N/mm], ``h``, ``H`` [mm], ``V``
         [mm/s], ``slab_order`` (text, e.g. "4,3,2,1,5"), ``shuffled`` and ``file``.
     shuffled : bool
@@ -148,7 +148,7 @@ def median_run(interfaces, events, *, n, a):
     rank : tuple of int
         ``(rank, count)``: its place (1-based) among the runs sorted by ``R_slow`` of ``a``.
     """
-    runs = interfaces[(interfaces["protocol"] == "stack") & (interfaces["n"] == n) & (interfaces["a"] == a)]
+    runs = interfaces[(interfaces["protocol"] == "stack") & (interfaces["n"] == n) & (interfaces["interface"] == a)]
     runs = runs[np.isfinite(runs["R_slow"].to_numpy(dtype=float))]
     if runs.empty:
         raise h5io.FileFormatError(f"no {EVENTS} file with n = {n} and a slow-slip fraction of a = {a}")

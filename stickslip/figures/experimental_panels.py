@@ -19,7 +19,7 @@ __all__ = ["LABELS", "single_slips", "distributions_by_n", "aging_panel",
 
 #: Axis labels of the slip quantities (with units).
 LABELS = {"dF": r"$\Delta F$ (N)", "dmu": r"$\Delta\mu_a$", "T": r"$T_a$ (s)", "B_a": r"$B_a$",
-          "dR": r"$\Delta R_a$ (mm)", "dR_from_dF": r"$\Delta R_a(\Delta F)$ (mm)"}
+          "slip": r"$\Delta R_a$ (mm)", "slip_from_dF": r"$\Delta R_a(\Delta F)$ (mm)"}
 
 
 def single_slips(slips, protocol=None):
@@ -53,11 +53,11 @@ def distributions_by_n(ax, slips, a, column, edges, *, individual=True, logarith
     """
     single = single_slips(slips)
     groups = [(stack_n, n_style(stack_n), {"gid": f"n={stack_n}"}) for stack_n in
-              sorted(single.loc[(single["protocol"] == "stack") & (single["a"] == a), "n"].unique())]
+              sorted(single.loc[(single["protocol"] == "stack") & (single["interface"] == a), "n"].unique())]
     if individual:
         groups.append((None, individual_style(), {"linestyle": "--", "gid": "reference"}))
     for n, style, extra in groups:
-        part = single[(single["a"] == a) & ((single["protocol"] == "individual") if n is None
+        part = single[(single["interface"] == a) & ((single["protocol"] == "individual") if n is None
                                             else (single["protocol"] == "stack") & (single["n"] == n))]
         plot_density(ax, part[column], edges, logarithmic=logarithmic, **style, **extra)
     name = LABELS[column].split(" (")[0]
@@ -70,7 +70,7 @@ def distributions_by_n(ax, slips, a, column, edges, *, individual=True, logarith
         ax.set_ylabel(f"$P$({name})")
 
 
-def aging_panel(ax, slips, *, color_by="a", t0=aging.T0, fit=True):
+def aging_panel(ax, slips, *, color_by="interface", t0=aging.T0, fit=True):
     """``dmu_a`` against ``T_a`` (semi-logarithmic), with log-binned means and the aging fit.
 
     Parameters
@@ -78,7 +78,7 @@ def aging_panel(ax, slips, *, color_by="a", t0=aging.T0, fit=True):
     ax : matplotlib.axes.Axes
     slips : pandas.DataFrame
         Slips to show (single slips with a waiting time are used).
-    color_by : {"a", "n"}
+    color_by : {"interface", "n"}
         Colour by interface (marker by ``n``) or by ``n`` (marker by interface).
     t0 : float
         Aging time scale [s].
@@ -93,22 +93,22 @@ def aging_panel(ax, slips, *, color_by="a", t0=aging.T0, fit=True):
     """
     data = single_slips(slips)
     data = data[np.isfinite(data["T"].to_numpy(dtype=float)) & np.isfinite(data["dmu"].to_numpy(dtype=float))]
-    other = "n" if color_by == "a" else "a"
+    other = "n" if color_by == "interface" else "interface"
     for key in sorted(data[color_by].unique()):
         for second in sorted(data[other].unique()):
             part = data[(data[color_by] == key) & (data[other] == second)]
             if part.empty:
                 continue
-            colour = (a_style if color_by == "a" else n_style)(key)["color"]
-            marker = (n_style if color_by == "a" else a_style)(second)["marker"]
+            colour = (a_style if color_by == "interface" else n_style)(key)["color"]
+            marker = (n_style if color_by == "interface" else a_style)(second)["marker"]
             ax.plot(part["T"], part["dmu"], linestyle="none", marker=marker, markersize=2.5, alpha=0.35,
                     color=colour, markeredgewidth=0)
     # Legend proxies: colours, then markers.
     for key in sorted(data[color_by].unique()):
-        style = (a_style if color_by == "a" else n_style)(key)
+        style = (a_style if color_by == "interface" else n_style)(key)
         ax.plot([], [], linestyle="none", marker="o", color=style["color"], label=style["label"], markersize=4)
     for second in sorted(data[other].unique()):
-        style = (n_style if color_by == "a" else a_style)(second)
+        style = (n_style if color_by == "interface" else a_style)(second)
         ax.plot([], [], linestyle="none", marker=style["marker"], color="grey", label=style["label"], markersize=4)
     ax.set_xscale("log")
     ax.set_xlabel(LABELS["T"])
@@ -140,7 +140,7 @@ def disorder_law_lines(ax, slips, T_range):
     alone = slips[slips["protocol"] == "individual"]
     rates = {round(float(kinematics.mu_loading_rate(a, 1, "individual", k_spring=K, h=h, H=H, V=V,
                                                     normal_force=N)), 12)
-             for a, K, h, H, V, N in alone[["a", "k_spring", "h", "H", "V", "normal_force"]].drop_duplicates()
+             for a, K, h, H, V, N in alone[["interface", "k_spring", "h", "H", "V", "normal_force"]].drop_duplicates()
              .itertuples(index=False)}
     T = np.linspace(*T_range, 50)
     for index, rate in enumerate(sorted(rates)):
@@ -171,7 +171,7 @@ def slow_slip_fraction_panel(ax, interfaces, shuffled=None):
         if table is None or table.empty:
             continue
         stack = table[(table["protocol"] == "stack") & table["driven"].to_numpy(dtype=bool)]
-        for a, part in stack.groupby("a"):
+        for a, part in stack.groupby("interface"):
             summary = part.groupby("n")["R_slow"].agg(mean="mean", sem="sem", runs="size").reset_index()
             drawn.append(summary.assign(a=a, shuffled=is_shuffled))
             style = a_style(a)

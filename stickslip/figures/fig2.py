@@ -136,7 +136,7 @@ def _drop_panel(ax, groups, bins):
         per = pooled(files, "slip_interfaces")
         if per.empty:
             continue
-        dmu = per["dmu"].to_numpy()[per["single"].to_numpy(dtype=bool)]
+        dmu = per["dmu_sig0"].to_numpy()[~per["multi"].to_numpy(dtype=bool)]
         samples[n] = dmu
         plot_density(ax, dmu, range_edges(dmu, bins), **{**n_style(n), "label": f"$n = {n}$ ({dmu.size})"})
     ax.set_xlabel(r"$\Delta\mu_a / \sigma_0$")

@@ -33,10 +33,10 @@ def force_panel(ax, record, slips, t_range):
     shown = slips[(slips["t_start"] >= t_range[0]) & (slips["t_end"] <= t_range[1])].drop_duplicates("event")
     for _, slip in shown.iterrows():
         before = np.searchsorted(record.t_F, slip["t_start"], side="right") - 1
-        colour = "black" if slip["multi"] else interface_color(slip["a"])
-        ax.plot([slip["t"], slip["t"]], [record.F[before], record.F[before] - slip["dF"]], color=colour,
+        colour = "black" if slip["multi"] else interface_color(slip["interface"])
+        ax.plot([slip["time"], slip["time"]], [record.F[before], record.F[before] - slip["dF"]], color=colour,
                 linewidth=2.0, solid_capstyle="butt")
-    for a in sorted(shown["a"].unique()):
+    for a in sorted(shown["interface"].unique()):
         ax.plot([], [], color=interface_color(a), linewidth=2.0, label=f"$a = {a}$")
     ax.set_ylabel("$F$ (N)")
     legend_outside(ax, handlelength=1.0)
@@ -64,17 +64,18 @@ def draw(params, inputs):
     legend_outside(ax_R, handlelength=1.0)
 
     stack = single_slips(slips, "stack")
-    one = stack[stack["a"] == 1]
+    one = stack[stack["interface"] == 1]
     distributions_by_n(ax_dF, slips, 1, "dF", linear_edges(one["dF"], 30), individual=False)
     legend_outside(ax_dF, title="$a = 1$")
 
     # Open markers, a shape and a size per interface, translucent, the most numerous drawn first: overlaps stay
     # legible.
-    for a in stack["a"].value_counts().index:
-        part = stack[stack["a"] == a]
-        ax_dR.plot(part["dR_from_dF"], part["dR"], linestyle="none", gid=f"a={a}", alpha=0.6,
+    for a in stack["interface"].value_counts().index:
+        part = stack[stack["interface"] == a]
+        ax_dR.plot(part["slip_from_dF"], part["slip"], linestyle="none", gid=f"a={a}", alpha=0.6,
                    **{**hollow(a_style(a), MARKER_SIZE - MARKER_STEP * (a - 1)), "markeredgewidth": 0.6})
-    limits = np.array([np.nanmin(stack[["dR", "dR_from_dF"]].to_numpy()), np.nanmax(stack[["dR", "dR_from_dF"]].to_numpy())])
+    both = stack[["slip", "slip_from_dF"]].to_numpy()
+    limits = np.array([np.nanmin(both), np.nanmax(both)])
     limits = np.array([max(limits[0], 1e-3) / 1.2, limits[1] * 1.2])
     ax_dR.plot(limits, limits, color="black", linewidth=0.8, linestyle="--", label=r"$y = x$")
     ax_dR.set_xscale("log")
@@ -83,7 +84,7 @@ def draw(params, inputs):
         axis.set_minor_formatter(NullFormatter())
     ax_dR.set_xlim(limits)
     ax_dR.set_ylim(limits)
-    ax_dR.set_xlabel(LABELS["dR_from_dF"])
+    ax_dR.set_xlabel(LABELS["slip_from_dF"])
     ax_dR.set_ylabel(r"$\Delta R_a$ measured (mm)")
     entries = sorted(zip(*ax_dR.get_legend_handles_labels()), key=lambda entry: (entry[1] == r"$y = x$", entry[1]))
     legend_outside(ax_dR, handles=[handle for handle, _ in entries], labels=[label for _, label in entries])

@@ -28,7 +28,7 @@ def draw(params, inputs):
     rows = -(-params.interfaces // columns)
     fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 2.7 * rows), layout="constrained", squeeze=False)
     for a, ax in zip(range(1, params.interfaces + 1), axes.ravel()):
-        edges = linear_edges(single.loc[single["a"] == a, "dmu"], params.bins)
+        edges = linear_edges(single.loc[single["interface"] == a, "dmu"], params.bins)
         distributions_by_n(ax, slips, a, "dmu", edges)
         ax.set_title(f"$a = {a}$", loc="right", fontsize=9)
         legend_outside(ax)

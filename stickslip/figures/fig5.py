@@ -27,8 +27,8 @@ def individual_panel(ax, slips):
     """dmu_a against T_a of the individually driven interfaces, with the disorder law."""
     alone = single_slips(slips, "individual")
     alone = alone[np.isfinite(alone["T"].to_numpy(dtype=float))]
-    for a in sorted(alone["a"].unique()):
-        part = alone[alone["a"] == a]
+    for a in sorted(alone["interface"].unique()):
+        part = alone[alone["interface"] == a]
         ax.plot(part["T"], part["dmu"], linestyle="none", markersize=3, alpha=0.6, markeredgewidth=0, gid=f"a={a}",
                 **a_style(a))
     if not alone.empty:
@@ -46,7 +46,8 @@ def draw(params, inputs):
     fig, axes = plt.subplots(1, 3, figsize=(12.0, 3.3), layout="constrained")
     individual_panel(axes[0], slips)
     stack = single_slips(slips, "stack")
-    distributions_by_n(axes[1], slips, 1, "T", log_edges(stack.loc[stack["a"] == 1, "T"], params.bins_per_decade),
+    distributions_by_n(axes[1], slips, 1, "T",
+                       log_edges(stack.loc[stack["interface"] == 1, "T"], params.bins_per_decade),
                        individual=False, logarithmic=True)
     legend_outside(axes[1], title="$a = 1$")
     aging_panel(axes[2], stack, t0=params.t0)

@@ -38,7 +38,7 @@ def spread_panel(ax, slips):
         :func:`~stickslip.experiment.aging.spread_of_aging_rate`, what is drawn.
     """
     table = spread_of_aging_rate(slips)
-    for a, part in table.groupby("a"):
+    for a, part in table.groupby("interface"):
         part = part[np.isfinite(part["std_normalised"])]
         if len(part) > 1:
             errors = part["std_normalised_error"].to_numpy(dtype=float)
@@ -63,9 +63,9 @@ def slow_slip_example(ax, record, slips, a, duration, note):
     R = record.R[window, a - 1]
     t = record.t_x[window]
     ax.plot(t, R - R[0], color=interface_color(a), linewidth=1.0, label=rf"$R_{a}(t) - R_{a}(t_0)$")
-    own = slips[(slips["a"] == a) & (slips["t_start"] >= t_from)]
-    steps = np.concatenate([[0.0], np.cumsum(own["dR"].to_numpy())])
-    times = np.concatenate([[t_from], own["t"].to_numpy(), [t[-1]]])
+    own = slips[(slips["interface"] == a) & (slips["t_start"] >= t_from)]
+    steps = np.concatenate([[0.0], np.cumsum(own["slip"].to_numpy())])
+    times = np.concatenate([[t_from], own["time"].to_numpy(), [t[-1]]])
     ax.step(times, np.append(steps, steps[-1]), where="post", color="black", linewidth=0.8,
             label=r"$\sum \Delta R_a$ (slip events)")
     total = R[-1] - R[0]
@@ -87,7 +87,7 @@ def draw(params, inputs):
     run_slips = slips[slips["file"] == chosen]
     fig, axes = plt.subplots(2, 2, figsize=(8.0, 5.4), layout="constrained")
     one = single_slips(slips, "stack")
-    edges = linear_edges(one.loc[one["a"] == 1, "B_a"], params.bins)
+    edges = linear_edges(one.loc[one["interface"] == 1, "B_a"], params.bins)
     distributions_by_n(axes[0, 0], slips, 1, "B_a", edges, individual=False)
     legend_outside(axes[0, 0], title="$a = 1$")
     spread_panel(axes[0, 1], slips)

@@ -135,7 +135,7 @@ def draw(params, inputs):
     for strengthening, color in ((params.strengthening, "C0"), (0.0, "0.4")):
         chosen = select_runs(runs, n=1, temperature=params.temperature, strengthening=strengthening)
         for rate, group in chosen.groupby("drive_rate"):
-            peaks = np.concatenate([item.tables["slip_events"]["mu_before"].to_numpy() for item in group["data"]])
+            peaks = np.concatenate([item.tables["slip_events"]["mu_before_sig0"].to_numpy() for item in group["data"]])
             mean, sem, _ = mean_sem(peaks)
             ax[4].errorbar([rate], [mean], yerr=[sem], marker="o", color=color, capsize=2)
         ax[4].plot([], [], "o", color=color, label=f"lambda = {strengthening:g}")
@@ -149,13 +149,13 @@ def draw(params, inputs):
         if chosen.empty:
             continue
         slips = pd.concat([item.tables["slip_events"] for item in chosen["data"]], ignore_index=True)
-        single = slips[~slips["multi"].astype(bool) & np.isfinite(slips["T"])]
+        single = slips[~slips["multi"].astype(bool) & np.isfinite(slips["T_fe"])]
         T0 = float(chosen["T0"].iloc[0])
-        bins = log_binned(single["T"], single["dmu"])
+        bins = log_binned(single["T_fe"], single["dmu_sig0"])
         style = n_style(n)
         ax[5].errorbar(bins["T"] / T0, bins["dmu_mean"], yerr=bins["dmu_std"] / np.sqrt(bins["count"]), capsize=2,
                        **style)
-        x = np.geomspace(max(single["T"].min(), T0), single["T"].max(), 20)
+        x = np.geomspace(max(single["T_fe"].min(), T0), single["T_fe"].max(), 20)
         for kind, line in (("origin", "--"), ("intercept", "-")):
             fit = estimator(single, T0, kind)
             if np.isfinite(fit["B"]):

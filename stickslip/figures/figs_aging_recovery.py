@@ -87,7 +87,7 @@ def recovery(slips, pairs, t0=aging.T0):
         origin = aging.fit_aging(part["T"], part["dmu"], t0=t0, fit="origin")
         free = aging.fit_aging(part["T"], part["dmu"], t0=t0, fit="intercept")
         fits.append((rs_a, rs_b, origin.B, origin.B_error, free.B, free.B_error, free.c, free.c_error, len(part)))
-        first = part[part["a"] == 1]
+        first = part[part["interface"] == 1]
         per_run = first.groupby(["n", "file"])["B_a"].mean().groupby("n")
         table = per_run.agg(["mean", "sem"]).reset_index()
         reference = table.loc[table["n"] == table["n"].min(), "mean"].iloc[0]

@@ -27,7 +27,7 @@ def draw(params, inputs):
     stack = single_slips(slips, "stack")
     alone = single_slips(slips, "individual")
     fig, axes = plt.subplots(2, 2, figsize=(10.0, 6.4), layout="constrained")
-    aging_panel(axes[0, 0], stack, color_by="a", t0=params.t0)
+    aging_panel(axes[0, 0], stack, color_by="interface", t0=params.t0)
     aging_panel(axes[0, 1], stack, color_by="n", t0=params.t0)
     fit = aging_panel(axes[1, 0], stack, color_by="n", t0=params.t0)
     axes[1, 0].plot(alone["T"], alone["dmu"], linestyle="none", markersize=3, alpha=0.7, markeredgewidth=0,
@@ -35,7 +35,7 @@ def draw(params, inputs):
     if not alone.empty:  # the disorder law over the narrow range of T_a the individual slips explore
         disorder_law_lines(axes[1, 0], slips, (0.8 * alone["T"].min(), 1.2 * alone["T"].max()))
     quiet = without_slow_slip(stack)
-    aging_panel(axes[1, 1], quiet, color_by="a", t0=params.t0)
+    aging_panel(axes[1, 1], quiet, color_by="interface", t0=params.t0)
     axes[1, 1].text(0.97, 0.03, f"no slow slip: {len(quiet)} of {len(stack)} slips", transform=axes[1, 1].transAxes,
                     ha="right", va="bottom", fontsize=7)
     if fit is not None:

@@ -39,7 +39,7 @@ def run(params, inputs, output):
             per = pooled(files, "slip_interfaces")
             if group_regime != regime or per.empty or n < params.interface:
                 continue
-            dgamma = per["dgamma"].to_numpy()[per["a"].to_numpy() == params.interface]
+            dgamma = per["dgamma"].to_numpy()[per["interface"].to_numpy() == params.interface]
             dgamma = dgamma[np.isfinite(dgamma)]  # the first slip of each run has no predecessor (NaN)
             plot_density(ax, dgamma, range_edges(dgamma, params.bins),
                          **{**n_style(n), "label": f"$n = {n}$ ({dgamma.size})"})

@@ -27,23 +27,23 @@ def draw(params, inputs):
     """The figure (not saved): what :func:`run` writes; the tests read its plotted data."""
     alone = single_slips(load_slips(inputs[EVENTS]), "individual")
     fig, axes = plt.subplots(1, 3, figsize=(11.0, 3.2), layout="constrained")
-    interfaces = sorted(alone["a"].unique())
+    interfaces = sorted(alone["interface"].unique())
     for a in interfaces:
-        part = alone[alone["a"] == a]
-        axes[0].plot(part["dR_from_dF"], part["dR"], linestyle="none", markersize=3, alpha=0.6,
+        part = alone[alone["interface"] == a]
+        axes[0].plot(part["slip_from_dF"], part["slip"], linestyle="none", markersize=3, alpha=0.6,
                      markeredgewidth=0, **a_style(a))
     if not alone.empty:
-        values = alone[["dR", "dR_from_dF"]].to_numpy(dtype=float)
+        values = alone[["slip", "slip_from_dF"]].to_numpy(dtype=float)
         limits = np.array([np.nanmin(values) / 1.1, np.nanmax(values) * 1.1])
         axes[0].plot(limits, limits, color="black", linestyle="--", linewidth=0.8, label="$y = x$")
         axes[0].set_xlim(limits)
         axes[0].set_ylim(limits)
-    axes[0].set_xlabel(LABELS["dR_from_dF"])
+    axes[0].set_xlabel(LABELS["slip_from_dF"])
     axes[0].set_ylabel(r"$\Delta R_a$ measured (mm)")
     for column, ax in zip(("dF", "dmu"), axes[1:]):
         edges = linear_edges(alone[column], params.bins)
         for a in interfaces:
-            plot_density(ax, alone.loc[alone["a"] == a, column], edges, gid=f"a={a}", **a_style(a))
+            plot_density(ax, alone.loc[alone["interface"] == a, column], edges, gid=f"a={a}", **a_style(a))
         ax.set_xlabel(LABELS[column])
         ax.set_ylabel(f"$P$({LABELS[column].split(' (')[0]})")
     for ax in axes:

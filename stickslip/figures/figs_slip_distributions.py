@@ -28,7 +28,7 @@ def draw(params, inputs):
     fig, axes = plt.subplots(3, params.interfaces, figsize=(2.6 * params.interfaces + 1.2, 7.2), layout="constrained",
                              squeeze=False)
     for column, a in enumerate(range(1, params.interfaces + 1)):
-        own = single[single["a"] == a]
+        own = single[single["interface"] == a]
         distributions_by_n(axes[0, column], slips, a, "dmu", linear_edges(own["dmu"], params.bins))
         distributions_by_n(axes[1, column], slips, a, "T", log_edges(own["T"], params.bins_per_decade),
                            logarithmic=True)

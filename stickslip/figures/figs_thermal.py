@@ -229,13 +229,14 @@ def scaled_slips(runs, params, experiment):
     stacks = runs[_at_rate(runs, params)]
     for _, row in stacks.iterrows():
         slips = row["data"].tables["slip_events"]
-        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
+        slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T_fe"].to_numpy(dtype=float))]
         parts.append(pd.DataFrame({"source": "numerics", "n": row["n"], "a": slips["interface"].to_numpy(),
-                                   "T": slips["T"].to_numpy(dtype=float), "dmu": slips["dmu"].to_numpy(dtype=float)}))
+                                   "T": slips["T_fe"].to_numpy(dtype=float),
+                                   "dmu": slips["dmu_sig0"].to_numpy(dtype=float)}))
     if experiment is not None:
         exp = experiment[(experiment["protocol"] == "stack") & (experiment["n"] <= 3)
                          & ~experiment["multi"].to_numpy(dtype=bool) & np.isfinite(experiment["T"].to_numpy(dtype=float))]
-        parts.append(pd.DataFrame({"source": "experiment", "n": exp["n"].to_numpy(), "a": exp["a"].to_numpy(),
+        parts.append(pd.DataFrame({"source": "experiment", "n": exp["n"].to_numpy(), "a": exp["interface"].to_numpy(),
                                    "T": exp["T"].to_numpy(dtype=float), "dmu": exp["dmu"].to_numpy(dtype=float)}))
     table = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=["source", "n", "a", "T", "dmu"])
     for source, group in table.groupby("source"):
@@ -260,9 +261,9 @@ def rate_table(runs):
         slips = row["data"].tables["slip_events"]
         slips = slips[~slips["multi"].to_numpy(dtype=bool)]
         count = len(slips)
-        rows.append({"drive_rate": row["drive_rate"], "peak": slips["mu_before"].mean(),
-                     "peak_sem": slips["mu_before"].std(ddof=1) / np.sqrt(count),
-                     "dmu": slips["dmu"].mean(), "dmu_sem": slips["dmu"].std(ddof=1) / np.sqrt(count),
+        rows.append({"drive_rate": row["drive_rate"], "peak": slips["mu_before_sig0"].mean(),
+                     "peak_sem": slips["mu_before_sig0"].std(ddof=1) / np.sqrt(count),
+                     "dmu": slips["dmu_sig0"].mean(), "dmu_sem": slips["dmu_sig0"].std(ddof=1) / np.sqrt(count),
                      "slips": count})
     return pd.DataFrame(rows).sort_values("drive_rate", na_position="last").reset_index(drop=True)
 
@@ -280,12 +281,12 @@ def slow_slip_table(runs, params, experiment_interfaces):
     for source, where in (("thermal", _at_rate(runs, params)), ("athermal", ~runs["thermal"])):
         for _, row in runs[where].iterrows():
             table = row["data"].tables["interfaces"]
-            parts.append(pd.DataFrame({"source": source, "n": row["n"], "a": table["a"].to_numpy(),
+            parts.append(pd.DataFrame({"source": source, "n": row["n"], "a": table["interface"].to_numpy(),
                                        "R_slow": table["R_slow"].to_numpy(dtype=float)}))
     if experiment_interfaces is not None:
         exp = experiment_interfaces[(experiment_interfaces["protocol"] == "stack") & (experiment_interfaces["n"] <= 3)
                                     & experiment_interfaces["driven"].to_numpy(dtype=bool)]
-        parts.append(pd.DataFrame({"source": "experiment", "n": exp["n"].to_numpy(), "a": exp["a"].to_numpy(),
+        parts.append(pd.DataFrame({"source": "experiment", "n": exp["n"].to_numpy(), "a": exp["interface"].to_numpy(),
                                    "R_slow": exp["R_slow"].to_numpy(dtype=float)}))
     table = pd.concat(parts, ignore_index=True)
     grouped = table.groupby(["source", "n", "a"])["R_slow"]
@@ -314,8 +315,8 @@ def _fit_label(fit, scale=1.0):
 def _panel_shs(ax, runs, params):
     row = _one(runs, runs["thermal"] & runs["holds"] & (runs["n"] == 1), "thermal n = 1 run with hold cycles")
     slips = row["data"].tables["slip_events"]
-    slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T"].to_numpy(dtype=float))]
-    T, dmu, t0 = slips["T"].to_numpy(float), slips["dmu"].to_numpy(float), row["T0"]
+    slips = slips[~slips["multi"].to_numpy(dtype=bool) & np.isfinite(slips["T_fe"].to_numpy(dtype=float))]
+    T, dmu, t0 = slips["T_fe"].to_numpy(float), slips["dmu_sig0"].to_numpy(float), row["T0"]
     ax.plot(T / t0, dmu, "o", color="0.6", markersize=2.5, markeredgewidth=0, label=f"{len(slips)} slips")
     bins = log_binned(T / t0, dmu, bins_per_decade=params.bins_per_decade)
     ax.errorbar(bins["T"], bins["dmu_mean"], yerr=bins["dmu_std"] / np.sqrt(bins["count"]), fmt="s", color="black",
@@ -457,7 +458,7 @@ def draw(params, inputs):
         raise FileFormatError(f"figure 'figS-thermal': {held['file']} has no hold trials")
     _panel_holds(axes[0, 1], tables["holds"], held["T0"])
     _panel_barriers(axes[0, 2], tables["holds"], tables["barriers"], held["T0"])
-    interface = tables["interfaces"].set_index("a").loc[1]
+    interface = tables["interfaces"].set_index("interface").loc[1]
     _panel_creep(axes[0, 3], tables["holds"], tables["creep"], held["T0"], interface["dR_sum"] / interface["n_slips"])
     _panel_scaled(axes[1, 0], scaled_slips(runs, params, experiment), params)
     _panel_rate(axes[1, 1], rate_table(runs))

@@ -66,7 +66,7 @@ class Format:
         For simulation formats: the kind of data (a column of the database).
     describe : str or None
         ``"module:function"``: ``function(path) -> dict`` of the database's simulation
-        columns (``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``,
+        columns (``protocol``, ``n``, ``driven_slab``, ``plates``, ``blocks``, ``k_drive``,
         ``phi``, ``regime``, ``seed``, ``temperature``, ``attempt_rate``, ``drive_rate``, ``junction_strengthening``,
         ``junction_glass_temperature``, ``junction_attempt_rate``) read from one file.
     unstamped : int or None
@@ -209,7 +209,7 @@ for _builtin in (
         Format("timeseries", 1, "stickslip.experiment.timeseries", "an experimental recording: lever force F(t), "
                "slab positions x(t), apparatus attributes", source="experimental",
                describe="stickslip.experiment.timeseries:describe", unstamped=1),
-        Format("event-table", 1, "stickslip.formats.event_table", "slip events: one row per (event, slipping "
+        Format("event-table", 2, "stickslip.formats.event_table", "slip events: one row per (event, slipping "
                "interface) in the table 'slip_events', plus the analysis's own tables"),
         Format("front-table", 2, "stickslip.formats.front_table", "re-run events: block failures and rupture fronts"),
 ):

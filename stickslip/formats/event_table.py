@@ -10,12 +10,17 @@ add tables of its own beside it. Numerical (``numerical-events``) and experiment
 An optional one-row table ``periodicity`` (:data:`PERIODICITY_COLUMNS`) holds the periodicity
 and synchronisation measures of the run's slip events (:mod:`stickslip.events.periodicity`);
 the database keeps it in its table ``run_periodicity``.
+
+Version 2: the package's vocabulary (:mod:`stickslip.vocabulary`): a numerical analysis writes its drops in
+``dmu_sig0`` [sig0] and its clock in ``t`` [time], leaving ``dmu`` [1] and ``time`` [s] to the lab's; the
+periodicity counts are ``n_slips``, ``n_multi``, ``n_spanning``.
 """
 
 import numpy as np
 import pandas as pd
 
 from ..h5io import FileFormatError, read_table
+from ..vocabulary import QUANTITIES
 from .analysis_file import open_analysis_file
 
 __all__ = ["FORMAT", "TABLE", "COLUMNS", "REQUIRED", "PERIODICITY_TABLE", "PERIODICITY_COLUMNS", "slip_events_table",
@@ -26,17 +31,12 @@ FORMAT = "event-table"
 #: Name of the normalised table.
 TABLE = "slip_events"
 
-#: Columns: name -> (dtype, meaning). Optional columns may be left out; an analysis
-#: without a quantity leaves its column out (the database stores NULL).
-COLUMNS = {
-    "event": ("int64", "event index within the run, from 0"),
-    "interface": ("int64", "interface (slab) a that slipped, 1 = lowest"),
-    "multi": ("bool", "more than one interface slipped in the event"),
-    "slip": ("float64", "slip of the interface [mm] (experimental)"),
-    "dmu": ("float64", "drop of friction coefficient [-] (experimental) or interface stress [sig0] (numerical)"),
-    "time": ("float64", "time of the slip [s] (experimental)"),
-    "increment": ("int64", "increment of the event (numerical)"),
-}
+#: Columns: name -> (dtype, meaning), in order (:data:`stickslip.vocabulary.QUANTITIES`, units there). Optional
+#: columns may be left out; an analysis without a quantity leaves its column out (the database stores NULL).
+#: The lab's drop and clock (``dmu`` [1], ``time`` [s]) and the model's (``dmu_sig0`` [sig0], ``t`` [time])
+#: are separate columns.
+COLUMNS = {name: (QUANTITIES[name].dtype, QUANTITIES[name].doc)
+           for name in ("event", "interface", "multi", "slip", "dmu", "dmu_sig0", "time", "t", "increment")}
 
 #: Columns every table has.
 REQUIRED = ("event", "interface", "multi")
@@ -45,18 +45,9 @@ REQUIRED = ("event", "interface", "multi")
 PERIODICITY_TABLE = "periodicity"
 
 #: Its columns: name -> (dtype, meaning); every one is present (NaN where undefined).
-PERIODICITY_COLUMNS = {
-    "slips": ("int64", "steady-state slip events m"),
-    "multi": ("int64", "multi-slips (s > 1)"),
-    "spanning": ("int64", "system-spanning slips (s = n)"),
-    "interval_cv": ("float64", "coefficient of variation of the shear increment between consecutive slip events"),
-    "drop_cv": ("float64", "coefficient of variation of the macroscopic stress drops of the slip events"),
-    "multi_fraction": ("float64", "fraction of slip events that are multi-slips, rho(s > 1)"),
-    "spanning_fraction": ("float64", "fraction of slip events in which every interface slips"),
-    "alternation_cv": ("float64", "coefficient of variation of the number of single slips between consecutive "
-                                  "multi-slips"),
-    "runs_z": ("float64", "Wald-Wolfowitz runs statistic of the order of single and multi slips"),
-}
+PERIODICITY_COLUMNS = {name: (QUANTITIES[name].dtype, QUANTITIES[name].doc)
+                       for name in ("n_slips", "n_multi", "n_spanning", "interval_cv", "drop_cv", "multi_fraction",
+                                    "spanning_fraction", "alternation_cv", "runs_z")}
 
 
 def slip_events_table(table, source="slip table"):

@@ -24,7 +24,9 @@ import sqlalchemy.exc
 from sqlalchemy import select, text
 
 from ..h5io import FileFormatError
-from .database import SCHEMA_VERSION, Figure, Run, Simulation, engine_for
+from ..vocabulary import dtype_matches, expand_json, quantity, typed
+from . import filters as _filters
+from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
 
 __all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "TIME_LIMIT_S", "MAX_ROWS", "MEMORY_LIMIT_MIB",
            "CHECK_EVERY", "runs", "events", "figures", "sql"]
@@ -55,10 +57,6 @@ def _engine(database):
     return engine_for(path, readonly=True)
 
 
-#: Integer columns that an outer join may fill with NULL: kept as integers (pandas "Int64").
-INTEGER_COLUMNS = ("n", "a", "plates", "blocks", "seed", "threads", "event", "interface", "increment")
-
-
 #: PRAGMAs that ``db sql`` allows: they only describe the schema, whatever their argument.
 READ_ONLY_PRAGMAS = ("table_info", "table_xinfo", "table_list", "index_list", "index_info", "index_xinfo",
                      "foreign_key_list", "database_list")
@@ -78,8 +76,7 @@ def _check_schema(database, connection):
     """Raise QueryError unless the database has this package's schema version."""
     found = connection.execute(text("SELECT value FROM schema_info WHERE key = 'schema_version'")).scalar()
     if found is None or int(found) != SCHEMA_VERSION:
-        raise QueryError(f"{database}: database schema version {found}, expected {SCHEMA_VERSION}: "
-                         f"run `stickslip db rebuild`")
+        raise QueryError(f"database schema version {found}, expected {SCHEMA_VERSION}: {SCHEMA_HINT}")
 
 
 @contextmanager
@@ -174,99 +171,150 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
         raise QueryError(f"{database}: query failed: {cause}") from None
     finally:
         engine.dispose()
-    for column in INTEGER_COLUMNS:
-        if column in frame.columns:
-            frame[column] = frame[column].astype("Int64")
+    return typed(frame)
+
+
+#: The simulation columns of ``runs()`` (the run's own ``seed`` is the runs table's).
+SIMULATION_COLUMNS = ("solver", "source", "format", "path", "protocol", "n", "driven_slab", "plates", "blocks",
+                      "k_drive", "phi", "regime", "temperature", "attempt_rate", "drive_rate", "junction_strengthening",
+                      "junction_glass_temperature", "junction_attempt_rate")
+
+#: The tables of the filters whose values the database holds (``choices="database"``).
+_HELD = {"plugin": "runs", "solver": "simulations", "analysis": "slip_events"}
+
+
+def _parameters(names):
+    """For each plugin parameter name: [(plugin, its value's parser, its default)] of every plugin declaring it."""
+    import dataclasses
+
+    from .. import registry
+    from ..params import parse_value
+
+    found = {}
+    for kind in registry.KINDS:
+        for plugin in registry.available(kind).values():
+            for field in dataclasses.fields(plugin.params):
+                if field.name in names:
+                    default = list(field.default) if isinstance(field.default, tuple) else field.default
+                    found.setdefault(field.name, []).append(
+                        (plugin.name, lambda value, cls=plugin.params, name=field.name, owner=f"{kind} '{plugin.name}'":
+                         parse_value(cls, name, value, owner=owner), default))
+    return found
+
+
+def _checked(database, specs, filters):
+    """:func:`.filters.check` with the database's values and the plugins' parameters it needs."""
+    given = {name: value for name, value in filters.items() if value is not None}
+    known = {name: list(_frame(database, text(f"SELECT DISTINCT {name} FROM {_HELD[name]} WHERE {name} IS NOT NULL "
+                                              f"ORDER BY {name}"))[name])
+             for name in given if name in _HELD and any(spec.name == name for spec in specs)}
+    columns = {spec.name for spec in specs}
+    others = [name for name in given if name not in columns]
+    return _filters.check(specs, given, known=known, parameters=_parameters(others) if others else None)
+
+
+def _units(frame):
+    """``attrs["units"]`` of a query's frame: the vocabulary's unit of every column in the vocabulary's dtype."""
+    units = {}
+    for column in frame.columns:
+        found = quantity(column)
+        units[str(column)] = found.unit if found is not None and dtype_matches(frame[column].dtype, found.dtype) \
+            else None
+    frame.attrs["units"] = units
     return frame
 
 
-def _where(statement, filters):
-    for column, value in filters:
-        if value is not None:
-            statement = statement.where(column == value)
-    return statement
-
-
-def runs(database=DEFAULT_DATABASE, *, kind=None, plugin=None, solver=None, n=None, regime=None, seed=None):
+def runs(database=DEFAULT_DATABASE, **filters):
     """Return the runs, with their simulation parameters where they are simulations.
 
     Parameters
     ----------
     database : str or pathlib.Path
-    kind : {"solver", "analysis", "figure", "mesh"}, optional
-    plugin : str, optional
-    solver : str, optional
-        Only simulations of this solver.
-    n : int, optional
-        Only simulations with this number of driven interfaces.
-    regime : str, optional
-        Only simulations in this driving regime.
-    seed : int, optional
+    **filters
+        :data:`stickslip.provenance.filters.RUN_FILTERS` (``kind``, ``plugin``, ``solver``, ``n``, ``plates``,
+        ``blocks``, ``k_drive``, ``phi``, ``regime``, ``temperature``, ``seed``, ...) and any plugin parameter
+        (``backend="cpu"``): :mod:`stickslip.provenance.filters`.
 
     Returns
     -------
     pandas.DataFrame
-        One row per run: the ``runs`` columns, then ``solver``, ``source``,
-        ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``regime``, ``temperature``,
-        ``attempt_rate``, ``drive_rate``, ``junction_strengthening``, ``junction_glass_temperature``,
-        ``junction_attempt_rate`` (NULL for runs that are not simulations); ordered by kind, plugin, run id.
+        One row per run: ``run_id``, ``kind``, ``plugin``, ``plugin_version``, the simulation's
+        :data:`SIMULATION_COLUMNS` (missing for other runs), ``seed``, ``threads``, the code and machine
+        (``code_hash``, ``package_version``, ``git_commit``, ``git_dirty``, ``python_version``, ...,
+        ``host``), ``started_at``, ``finished_at`` (UTC datetimes), ``wall_time_s``, ``peak_memory_mib``,
+        ``record_path``, then one column ``params.<name>`` per parameter of the runs' plugins (missing where a
+        plugin has no such parameter). Typed (:func:`stickslip.vocabulary.typed`), ``attrs["units"]``
+        (``params.<name>``: None; :func:`stickslip.study` gives the plugins' units); ordered by kind, plugin,
+        run id.
+
+    Raises
+    ------
+    stickslip.params.ParameterError
+        A filter that does not exist or a value that does not fit it (one line naming it).
 
     Notes
     -----
     Cost: one indexed query; linear in the number of runs returned.
     """
-    columns = [Simulation.solver, Simulation.source, Simulation.protocol, Simulation.n, Simulation.a,
-               Simulation.plates, Simulation.blocks, Simulation.k_drive, Simulation.phi, Simulation.regime,
-               Simulation.temperature, Simulation.attempt_rate, Simulation.drive_rate, Simulation.junction_strengthening,
-               Simulation.junction_glass_temperature, Simulation.junction_attempt_rate]
-    statement = (select(Run, *columns).outerjoin(Simulation, Simulation.run_id == Run.run_id)
-                 .order_by(Run.kind, Run.plugin, Run.run_id))
-    statement = _where(statement, [(Run.kind, kind), (Run.plugin, plugin), (Simulation.solver, solver),
-                                   (Simulation.n, n), (Simulation.regime, regime), (Run.seed, seed)])
-    return _frame(database, statement)
+    checked = _checked(database, _filters.RUN_FILTERS, filters)
+    where, bound = _filters.conditions(checked, ["r.run_id"])
+    own = [c.name for c in Run.__table__.columns if c.name not in ("params", "versions", "seed")]
+    head, tail = own[:4], own[4:]
+    columns = ([f"r.{c}" for c in head] + [f"s.{c}" for c in SIMULATION_COLUMNS] + ["r.seed", "r.params"]
+               + [f"r.{c}" for c in tail])
+    statement = text(f"SELECT {', '.join(columns)} FROM runs AS r LEFT JOIN simulations AS s ON s.run_id = r.run_id"
+                     f"{where} ORDER BY r.kind, r.plugin, r.run_id").bindparams(**bound)
+    return _units(typed(expand_json(_frame(database, statement), "params", prefix="params.")))
 
 
-def events(database=DEFAULT_DATABASE, *, solver=None, analysis=None, source=None, n=None, interface=None,
-           regime=None, seed=None, run_id=None):
+def events(database=DEFAULT_DATABASE, **filters):
     """Return slip events with the parameters of their simulation.
 
     Parameters
     ----------
     database : str or pathlib.Path
-    solver, analysis : str, optional
-    source : {"numerical", "experimental"}, optional
-    n : int, optional
-        Number of driven interfaces of the simulation.
-    interface : int, optional
-        Interface (slab) ``a`` (1 = lowest).
-    regime : str, optional
-    seed : int, optional
-    run_id : str, optional
-        Only the events of this simulation.
+    **filters
+        :data:`stickslip.provenance.filters.EVENT_FILTERS` (``solver``, ``analysis``, ``source``, ``n``,
+        ``interface``, ``multi``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``regime``, ``seed``, ``run_id`` (of
+        the simulation), ...) and any plugin parameter of the simulation or the analysis
+        (:mod:`stickslip.provenance.filters`).
 
     Returns
     -------
     pandas.DataFrame
-        The ``slip_events_full`` view: one row per slip of one interface in one
-        event, with ``protocol``, ``n``, ``a``, ``plates``, ``blocks``, ``k_drive``, ``phi``,
-        ``regime``, ``seed``; ordered by simulation, event, interface.
+        The ``slip_events_full`` view: one row per slip of one interface in one event, with the parameters of its
+        simulation (``protocol``, ``n``, ``driven_slab``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``regime``,
+        ``seed``, ...), the JSON column ``extra`` expanded into one column per key (``dF``, ``T``, ``B_a``,
+        ``dgamma``, ... ; a key named like another column gets the prefix ``extra.``); typed, with
+        ``attrs["units"]``; ordered by simulation, event, interface.
+
+    Raises
+    ------
+    stickslip.params.ParameterError
+        A filter that does not exist or a value that does not fit it.
 
     Notes
     -----
     Cost: one query using the indexes on solver, interface and simulation;
     linear in the number of events returned (a paper-size study has ~10^5-10^6).
     """
-    conditions = {"solver": solver, "analysis": analysis, "source": source, "n": n, "interface": interface,
-                  "regime": regime, "seed": seed, "simulation_run_id": run_id}
-    used = {key: value for key, value in conditions.items() if value is not None}
-    where = " AND ".join(f"{key} = :{key}" for key in used)
-    statement = text("SELECT * FROM slip_events_full" + (f" WHERE {where}" if where else "")
-                     + " ORDER BY simulation_run_id, event, interface").bindparams(**used)
-    return _frame(database, statement)
+    checked = _checked(database, _filters.EVENT_FILTERS, filters)
+    where, bound = _filters.conditions(checked, ["s.simulation_run_id", "s.analysis_run_id"])
+    statement = text(f"SELECT s.* FROM slip_events_full AS s{where} "
+                     "ORDER BY s.simulation_run_id, s.event, s.interface").bindparams(**bound)
+    frame = expand_json(_frame(database, statement), "extra")
+    own = [c.name for c in SlipEvent.__table__.columns if c.name in frame.columns]  # a migrated table's order differs
+    return _units(typed(frame[own + [c for c in frame.columns if c not in own]]))
 
 
 def figures(database=DEFAULT_DATABASE):
     """Return the figures with the run that drew them (plugin version, code hash, time).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``run_id``, ``figure``, ``pdf``, ``png``, ``plugin_version``, ``code_hash``, ``finished_at`` (UTC),
+        ``git_commit``; with ``attrs["units"]``.
 
     Notes
     -----
@@ -274,7 +322,7 @@ def figures(database=DEFAULT_DATABASE):
     """
     statement = (select(Figure, Run.plugin_version, Run.code_hash, Run.finished_at, Run.git_commit)
                  .join(Run, Run.run_id == Figure.run_id).order_by(Figure.figure))
-    return _frame(database, statement)
+    return _units(_frame(database, statement))
 
 
 def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS,
@@ -301,6 +349,8 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     Returns
     -------
     pandas.DataFrame
+        Columns named as the vocabulary's in their dtype (:func:`stickslip.vocabulary.typed`: ``multi`` a
+        bool, ``started_at`` a datetime, ...); ``attrs["units"]`` gives their units (None for the others).
 
     Raises
     ------
@@ -315,5 +365,5 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     """
     if not query.strip():
         raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
-    return _frame(database, text(query), only_reading=True, time_limit=time_limit or None, max_rows=max_rows or None,
-                  memory_limit_mib=memory_limit_mib or None)
+    return _units(_frame(database, text(query), only_reading=True, time_limit=time_limit or None,
+                         max_rows=max_rows or None, memory_limit_mib=memory_limit_mib or None))

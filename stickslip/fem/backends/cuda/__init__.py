@@ -15,8 +15,8 @@ order, :mod:`.layout`). Against the CPU the round-off differs (other summation o
 device compiler fuses multiplies and adds): the same events from the same state within the
 reference tolerance, not the same bytes, so ``cuda`` is a value of the ``backend`` parameter with
 its own run ids. The exact relaxation solves on the host (:meth:`CudaBackend.correct`: the force
-out, the correction in, once per Newton iteration). Needs ``numba-cuda`` (``pip install
-stickslip[gpu]``) and a GPU with its driver; ``NUMBA_ENABLE_CUDASIM=1`` runs it on numba's CUDA
+out, the correction in, once per Newton iteration). Needs ``numba-cuda`` (``pip install -e
+".[gpu]"`` in a clone) and a GPU with its driver; ``NUMBA_ENABLE_CUDASIM=1`` runs it on numba's CUDA
 simulator (tests, tiny meshes).
 """
 
@@ -33,7 +33,7 @@ __all__ = ["CudaBackend", "run_ensemble"]
 def _why_not():
     """Why the device cannot be used ("" if it can)."""
     if importlib.util.find_spec("numba_cuda") is None:
-        return "numba-cuda is not installed; install the GPU extra: pip install stickslip[gpu]"
+        return "numba-cuda is not installed; install the GPU extra: pip install -e '.[gpu]' in a clone"
     from numba import cuda  # numba-cuda's target (numba's own is deprecated)
     from numba import config
 
