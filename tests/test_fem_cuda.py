@@ -282,6 +282,34 @@ def test_a_gpu_batch_is_one_job_that_writes_every_run_s_usual_file(numba_cuda, t
     assert backends == ["cuda", "cuda", "cuda", "structured"]
 
 
+def test_an_ensemble_computes_a_linear_response_in_a_batch_of_the_elastic_law(numba_cuda):
+    # Elastic(K, G) and Cusp(K, G) are equal tuples: the linear response of an ensemble's run was once computed by
+    # the cusp law's kernels in the run's own batch (its infinite yield strains gave NaN, the solve failed)
+    result = _run("""
+    from stickslip.fem.backends.cuda.batch import DeviceBatch
+    from stickslip.fem.backends.cuda.ensemble import Ensemble
+    from stickslip.fem.constants import derived_constants
+    from stickslip.fem.laws import Elastic
+    from stickslip.fem.stack import build_stack
+
+    params = FemParams(N=9, plates=2, nchunk=30)
+    mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+    model = build_stack(params, mesh, make_backend(), derived_constants(params, mesh)).model
+    elastic = model._replace(law=Elastic(*model.law), epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
+    ensemble = Ensemble(1)
+    cusp_batch, elastic_batch = ensemble.batch_for(model, mesh), ensemble.batch_for(elastic, mesh)
+    try:
+        DeviceBatch(cusp_batch.mesh, model.law, 1).attach(elastic, object())
+        refused = ""
+    except ValueError as error:
+        refused = str(error)
+    print(json.dumps({"laws": [type(cusp_batch.law).__name__, type(elastic_batch.law).__name__],
+                      "same": cusp_batch is elastic_batch, "refused": refused}))
+    """)
+    assert result["laws"] == ["Cusp", "Elastic"] and not result["same"]
+    assert result["refused"].startswith("a batch computes one law: Elastic(")
+
+
 def test_runs_minimising_in_different_batches_at_once_meet_in_one_round(numba_cuda):
     # two members of an ensemble: one in the batch of its interface law, one in the batch of the elastic law (its
     # linear response) at the same time; and a third that leaves while the others wait (its run ended)

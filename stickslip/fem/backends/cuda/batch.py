@@ -18,10 +18,16 @@ from .launch import LAUNCHES, Launcher
 from .minimise import EVENTS_FULL, RUNNING
 from .state import DeviceState
 
-__all__ = ["DeviceBatch", "EVENT_CAPACITY"]
+__all__ = ["DeviceBatch", "EVENT_CAPACITY", "same_law"]
 
 #: Rows of a recording slot's event buffer at first (emptied when full, grown when one step needs more).
 EVENT_CAPACITY = 1 << 16
+
+
+def same_law(first, second):
+    """True if two laws are one law: the same class and the same parameters (laws are named tuples, and two
+    classes' tuples with equal fields compare equal: ``Elastic(K, G) == Cusp(K, G)``)."""
+    return type(first) is type(second) and first == second
 
 
 class DeviceBatch:
@@ -46,7 +52,7 @@ class DeviceBatch:
 
     def attach(self, model, owner):
         """A free slot for ``model`` (its yield strains, drive stiffness); released when ``owner`` is collected."""
-        if model.law != self.law:
+        if not same_law(model.law, self.law):
             raise ValueError(f"a batch computes one law: {model.law!r} is not {self.law!r}")
         with self._lock:
             if not self._free:

@@ -9,7 +9,7 @@ a call comes from.
 
 import threading
 
-from .batch import DeviceBatch
+from .batch import DeviceBatch, same_law
 from .device import DeviceMesh
 
 __all__ = ["Ensemble", "Member"]
@@ -120,7 +120,7 @@ class Ensemble:
             elif not self.mesh.serves(model):
                 raise ValueError("an ensemble's runs must share the mesh, the operators, the time step and the drive")
             for batch in self._batches:
-                if batch.law == model.law:
+                if same_law(batch.law, model.law):
                     return batch
             batch = DeviceBatch(self.mesh, model.law, 2 * self.size, self.groups)
             self._batches.append(batch)
