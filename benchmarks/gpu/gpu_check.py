@@ -30,6 +30,7 @@ before a GPU is lent; its figures mean nothing.
 
 import contextlib
 import dataclasses
+import importlib.metadata
 import json
 import os
 import platform
@@ -45,13 +46,16 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 SMOKE = os.environ.get("GPU_CHECK_SMOKE") == "1"
 #: Sizes of the parts: the paper's mesh (N = 1458), the ensembles' (N = 162), steps timed, events, batches.
-SIZES = ({"big": 18, "mid": 9, "steps": 4, "launch": 2, "sanity_steps": 3, "events": 0, "big_events": 1,
-          "reference_increments": 1, "relaxation": "exact", "quiet_steps": 4, "alone_groups": (1, 2),
-          "sanity_groups": (1, 2), "batches": (2,), "batch_increments": 1, "cpu_steps": 2}
+SIZES = ({"big": 9, "mid": 9, "mid_plates": 2, "big_plates": (2,), "regimes": ("stiff",), "steps": 2, "launch": 2,
+          "sanity_steps": 2, "events": 0, "big_events": 1, "reference_increments": 1, "relaxation": "exact",
+          "quiet_steps": 4, "alone_groups": (1, 2), "sanity_groups": (1, 2), "batches": (2,), "seeds": (1, 2),
+          "batch_increments": 1, "cpu_steps": 2}
          if SMOKE else
-         {"big": 1458, "mid": 162, "steps": 4096, "launch": 1024, "sanity_steps": 300, "events": 4, "big_events": 1,
-          "reference_increments": 0, "relaxation": "dynamic", "quiet_steps": 0, "alone_groups": (16, 33, 66, None),
-          "sanity_groups": (1, 4, 16, None), "batches": (8, 32, 128, 264), "batch_increments": 24, "cpu_steps": 400})
+         {"big": 1458, "mid": 162, "mid_plates": 3, "big_plates": (2, 6), "regimes": ("stiff", "compliant"),
+          "steps": 4096, "launch": 1024, "sanity_steps": 300, "events": 4, "big_events": 1, "reference_increments": 0,
+          "relaxation": "dynamic", "quiet_steps": 0, "alone_groups": (16, 33, 66, None),
+          "sanity_groups": (1, 4, 16, None), "batches": (8, 32, 128, 264), "seeds": (1, 2, 3, 4),
+          "batch_increments": 24, "cpu_steps": 400})
 PRODUCER = ("fem", "gpu-check")
 
 
@@ -111,8 +115,11 @@ def part_preflight(out):
                 if line.startswith("model name")), platform.processor())
     versions = {}
     for package in ("numpy", "numba", "numba_cuda", "scipy", "h5py", "qdldl"):
-        module = __import__(package)
-        versions[package] = getattr(module, "__version__", "?")
+        __import__(package)  # importable, not only installed
+        versions[package] = importlib.metadata.version(package.replace("_", "-"))
+    import qdldl
+
+    versions["qdldl_from"] = str(Path(qdldl.__file__).parent)
     emit(out, part="preflight", gpu=name.decode() if isinstance(name, bytes) else str(name), nvvm=version,
          compute_capability=list(getattr(device, "compute_capability", (0, 0))),
          sm_count=getattr(device, "MULTIPROCESSOR_COUNT", 1), nvidia_smi=smi, cpu=cpu, cpus=os.cpu_count(),
@@ -127,9 +134,9 @@ def part_sanity(out):
     from stickslip.fem.stiffness import PAPER_PHI
     from stickslip.mesh import MeshParams, build_stack_mesh
 
-    N, steps = SIZES["mid"], SIZES["sanity_steps"]
-    params = FemParams(N=N, plates=3, seed=1, k_drive=k_drive(PAPER_PHI["stiff"], N), nchunk=200)
-    mesh = build_stack_mesh(MeshParams(N=N, plates=3))
+    N, plates, steps = SIZES["mid"], SIZES["mid_plates"], SIZES["sanity_steps"]
+    params = FemParams(N=N, plates=plates, seed=1, k_drive=k_drive(PAPER_PHI["stiff"], N), nchunk=200)
+    mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
     response = affine_response(params, mesh)
     cpu = kicked(params, mesh, make_backend(), response)
     cpu.stack.backend.advance(steps)
@@ -194,12 +201,11 @@ def part_fidelity(out):
          worst_relative=worst, seconds=seconds, within_1e_9=all(v < 1e-9 for v in worst.values()))
     _reference_run(second)
     emit(out, part="fidelity", check="reference N=9 twice", same_bytes_twice=first.read_bytes() == second.read_bytes())
-    N = SIZES["mid"]
-    mesh = build_stack_mesh(MeshParams(N=N, plates=3))
-    seeds = (1, 2, 3, 4)
+    N, plates, seeds = SIZES["mid"], SIZES["mid_plates"], SIZES["seeds"]
+    mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
 
     def params(seed):
-        return FemParams(N=N, plates=3, seed=seed, k_drive=k_drive(PAPER_PHI["stiff"], N), relaxation="exact",
+        return FemParams(N=N, plates=plates, seed=seed, k_drive=k_drive(PAPER_PHI["stiff"], N), relaxation="exact",
                          quiet_steps=SIZES["quiet_steps"], max_increments=SIZES["batch_increments"], backend="cuda")
 
     start = time.perf_counter()
@@ -211,8 +217,8 @@ def part_fidelity(out):
                                                             producer=PRODUCER) for seed in seeds])
     equal = [(directory / f"alone-{seed}.h5").read_bytes() == (directory / f"batch-{seed}.h5").read_bytes()
              for seed in seeds]
-    emit(out, part="fidelity", check=f"batch member = alone (N={N}, 3 plates, {SIZES['batch_increments']} increments)",
-         equal=equal, seconds_alone=alone, seconds_batch=time.perf_counter() - start)
+    emit(out, part="fidelity", check=f"batch member = alone (N={N}, {plates} plates, {SIZES['batch_increments']} "
+         "increments)", equal=equal, seconds_alone=alone, seconds_batch=time.perf_counter() - start)
 
 
 def _speed(out, plates):
@@ -250,7 +256,7 @@ def _speed(out, plates):
 
 
 def part_speed(out):
-    for plates in (2, 6):
+    for plates in SIZES["big_plates"]:
         _speed(out, plates)
 
 
@@ -264,9 +270,10 @@ def _events(out, backend_name, N, regime, count):
 
     if not count:
         return
-    params = FemParams(N=N, plates=3, seed=1, k_drive=k_drive(PAPER_PHI[regime], N), backend=backend_name,
+    plates = SIZES["mid_plates"]
+    params = FemParams(N=N, plates=plates, seed=1, k_drive=k_drive(PAPER_PHI[regime], N), backend=backend_name,
                        relaxation=SIZES["relaxation"], quiet_steps=SIZES["quiet_steps"])
-    mesh = build_stack_mesh(MeshParams(N=N, plates=3))
+    mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
     start = time.perf_counter()
     sim = Simulation(params, mesh, CudaBackend() if backend_name == "cuda" else make_backend(backend_name))
     setup = time.perf_counter() - start
@@ -278,7 +285,7 @@ def _events(out, backend_name, N, regime, count):
         sim.protocol.kick(params.margin)
         seconds.append(time.perf_counter() - start)
         steps.append(round((sim.stack.time - t0) / sim.stack.model.dt))
-        emit(out, part="events", backend=backend_name, N=N, plates=3, regime=regime, relaxation=params.relaxation,
+        emit(out, part="events", backend=backend_name, N=N, plates=plates, regime=regime, relaxation=params.relaxation,
              setup_seconds=setup, steps=steps[-1], seconds=seconds[-1],
              us_per_step=1e6 * seconds[-1] / max(steps[-1], 1),
              paper_protocol_hours=2000 * seconds[-1] / 3600 if N == 1458 else None)
@@ -286,7 +293,7 @@ def _events(out, backend_name, N, regime, count):
 
 def part_events(out):
     for N, count in ((SIZES["mid"], SIZES["events"]), (SIZES["big"], SIZES["big_events"])):
-        for regime in ("stiff", "compliant"):
+        for regime in SIZES["regimes"]:
             _events(out, "cuda", N, regime, count)
 
 
@@ -299,7 +306,7 @@ def part_cpu_step(out):
 
     set_num_threads(1)
     N, steps = SIZES["big"], SIZES["cpu_steps"]
-    for plates in (2, 6):
+    for plates in SIZES["big_plates"]:
         params = FemParams(N=N, plates=plates, nchunk=200)
         mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
         sim = kicked(params, mesh, make_backend(), affine_response(params, mesh))

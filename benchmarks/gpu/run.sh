@@ -5,8 +5,10 @@
 # A 10 s preflight (device, NVVM, packages; qdldl from the carried wheel if the machine lacks it) stops the call at
 # once if it fails; then one Python process per part, each under its limit (they sum to 350 s), the CPU baseline
 # beside them. Results go to a scratch folder; OUTDIR gets 4 files: summary.txt, results.jsonl, gpu.log and
-# rest.tar.gz (the part logs, the run files). The summary is printed last.
+# rest.tar.gz (the part logs, the run files). The summary is printed last; the exit status is 1 if the preflight
+# failed or a part FAILED or is MISSING (summary.py), else 0.
 # Smoke mode on numba's simulator: GPU_CHECK_SMOKE=1 NUMBA_ENABLE_CUDASIM=1 bash benchmarks/gpu/run.sh OUTDIR
+# (tiny sizes: the script and its parts run; its figures mean nothing; tests/test_gpu_check.py).
 set -u
 OUT=${1:?usage: run.sh OUTDIR}
 mkdir -p "$OUT"
@@ -16,25 +18,28 @@ ROOT=$PWD
 PY=${PYTHON:-python3}
 DEVICE=${DEVICE_DIR:-$ROOT/.device}
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/stickslip-gpu-check.XXXXXX")
+trap 'rm -rf "$SCRATCH"' EXIT  # what OUTDIR needs is copied there (finish)
 mkdir -p "$SCRATCH/site" "$SCRATCH/logs"
 export PYTHONPATH=$SCRATCH/site:$ROOT${PYTHONPATH:+:$PYTHONPATH}
 export PYTHONUNBUFFERED=1 NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-export NUMBA_CACHE_DIR=$SCRATCH/numba-cache GPU_CHECK_REFERENCE=$DEVICE/reference/FixedLever_historic.h5
+export GPU_CHECK_REFERENCE=$DEVICE/reference/FixedLever_historic.h5
 start=$SECONDS
 check="$PY benchmarks/gpu/gpu_check.py"
 # limits [s] of the parts (350 s together with the preflight's 10); the simulator's smoke run gets more
 PARTS="sanity:50 fidelity:120 speed:100 events:70"
-SCALE=1; [ "${GPU_CHECK_SMOKE:-}" = 1 ] && SCALE=3
+SCALE=1; [ "${GPU_CHECK_SMOKE:-}" = 1 ] && SCALE=2
 
 finish() {
     $PY benchmarks/gpu/summary.py "$SCRATCH" > "$SCRATCH/summary.txt" 2>&1
+    status=$?
     echo "wall seconds: $((SECONDS - start))" >> "$SCRATCH/summary.txt"
     cp "$SCRATCH/summary.txt" "$OUT/summary.txt"
     [ -f "$SCRATCH/results.jsonl" ] && cp "$SCRATCH/results.jsonl" "$OUT/results.jsonl"
     cat "$SCRATCH"/logs/gpu-*.log > "$OUT/gpu.log" 2>/dev/null
-    tar -czf "$OUT/rest.tar.gz" -C "$SCRATCH" --exclude site --exclude numba-cache --exclude summary.txt \
+    tar -czf "$OUT/rest.tar.gz" -C "$SCRATCH" --exclude site --exclude summary.txt \
         --exclude results.jsonl . 2>/dev/null
     cat "$OUT/summary.txt"
+    return $status
 }
 
 # preflight: qdldl from the carried wheel of this Python where the machine lacks it; the device and NVVM
@@ -43,7 +48,7 @@ if ! $PY -c "import qdldl" 2>/dev/null; then
     wheel=$(ls "$DEVICE"/wheels/qdldl-*-"$tag"-*.whl 2>/dev/null | head -n 1)
     [ -n "$wheel" ] && $PY -m zipfile -e "$wheel" "$SCRATCH/site"
 fi
-if ! timeout 10 $check preflight "$SCRATCH" > "$SCRATCH/logs/gpu-preflight.log" 2>&1; then
+if ! timeout $((10 * SCALE)) $check preflight "$SCRATCH" > "$SCRATCH/logs/gpu-preflight.log" 2>&1; then
     echo "preflight failed (no device, no NVVM or a missing package; see gpu.log): the check stops" \
         >> "$SCRATCH/logs/gpu-preflight.log"
     finish

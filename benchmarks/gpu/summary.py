@@ -1,7 +1,8 @@
 """The table of a GPU check (benchmarks/gpu/run.sh): reads DIR/results.jsonl, prints the summary.
 
 Every part of the check is named in the last line: its time, or FAILED (an error) or MISSING (started and never
-ended: its limit, or a crash; or never started).
+ended: its limit, or a crash; or never started). The exit status is 1 if a part FAILED or is MISSING (run.sh
+exits with it), else 0.
 """
 
 import json
@@ -13,6 +14,7 @@ PARTS = ("preflight", "sanity", "fidelity", "speed", "events", "cpu-step")
 
 
 def main(directory):
+    """Print the summary of ``directory``'s results; returns the exit status (module docstring)."""
     path = Path(directory) / "results.jsonl"
     records = [json.loads(line) for line in path.read_text().splitlines() if line.strip()] if path.exists() else []
     by = {}
@@ -22,7 +24,7 @@ def main(directory):
     for r in by.get("preflight", []):
         print(f"GPU {r['gpu']} (cc {r['compute_capability']}, {r['sm_count']} SMs; {r['nvidia_smi']}), NVVM {r['nvvm']}, "
               f"CPU {r['cpu']} x {r['cpus']}, Python {r['python']}, numba {r['numba']}, numba-cuda {r['numba_cuda']}, "
-              f"numpy {r['numpy']}, qdldl {r['qdldl']}")
+              f"numpy {r['numpy']}, qdldl {r['qdldl']} ({r['qdldl_from']})")
     cpu = {r["plates"]: r for r in by.get("cpu-step", [])}
     print("\nspeed (us per step of the batch; per realisation-step; element-steps/s; ratio to one CPU core)")
     for r in by.get("speed", []):
@@ -49,7 +51,8 @@ def main(directory):
     failed = {r["part"] for r in records if "error" in r}
     print("\nparts: " + ", ".join(f"{name} FAILED" if name in failed else f"{name} {ended[name]:.0f} s" if name in ended
                                   else f"{name} MISSING" for name in PARTS))
+    return 1 if failed or set(PARTS) - set(ended) else 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    sys.exit(main(sys.argv[1]))

@@ -9,6 +9,8 @@ ends the launch and :class:`BarrierTimeout` is raised, never a hang.
 """
 
 import collections
+import contextlib
+import sys
 import threading
 
 import numba
@@ -19,7 +21,8 @@ from .kernels import kernels_for
 from .records import Launch
 from .sync import BARRIER_TIMEOUT
 
-__all__ = ["Launcher", "BarrierTimeout", "LAUNCHES", "STEPS_PER_LAUNCH", "DEADLINE_CYCLES", "threads_per_block"]
+__all__ = ["Launcher", "BarrierTimeout", "LAUNCHES", "launching", "STEPS_PER_LAUNCH", "DEADLINE_CYCLES",
+           "threads_per_block"]
 
 #: Time steps of one launch of a minimisation at most (then the host reads the status words and relaunches).
 STEPS_PER_LAUNCH = 4096
@@ -27,9 +30,30 @@ STEPS_PER_LAUNCH = 4096
 #: Clock cycles a block waits at a barrier before it gives up (about 10 s at 2 GHz; ns on the simulator).
 DEADLINE_CYCLES = 20_000_000_000
 
-#: Held around every launch: an ensemble's runs launch from their own threads (numba's simulator executes a
-#: launch in the caller and is not safe for launches from two threads at once).
+#: Held around every launch and while kernels are built: an ensemble's runs launch from their own threads (numba's
+#: simulator executes a launch in the caller, is not safe for launches from two threads at once, and replaces the
+#: ``cuda`` of the kernels' modules by its own while a launch runs).
 LAUNCHES = threading.RLock()
+
+#: The interpreter's thread switch interval [s] during a launch on numba's simulator. The simulator polls a block's
+#: threads while holding the GIL and releases a ``syncthreads`` only when it runs again: at Python's default (5 ms) a
+#: block barrier costs up to a slice per thread, and a force evaluation of an N = 9 stack about 1 s.
+SIMULATOR_SWITCH_INTERVAL = 5e-4
+
+
+@contextlib.contextmanager
+def launching():
+    """Hold :data:`LAUNCHES`; on the simulator, switch threads every :data:`SIMULATOR_SWITCH_INTERVAL` meanwhile."""
+    with LAUNCHES:
+        if not config.ENABLE_CUDASIM:
+            yield
+            return
+        interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(interval, SIMULATOR_SWITCH_INTERVAL))
+        try:
+            yield
+        finally:
+            sys.setswitchinterval(interval)
 
 
 class BarrierTimeout(RuntimeError):
@@ -64,7 +88,8 @@ class Launcher:
     def __init__(self, mesh, law, groups=None, deadline=None):
         self.mesh, self.law, self.groups = mesh, law, groups
         self.deadline = int(DEADLINE_CYCLES if deadline is None else deadline)
-        self.kernels = kernels_for(type(law).name)
+        with LAUNCHES:  # the simulator swaps the kernel modules' ``cuda`` for its own during a launch
+            self.kernels = kernels_for(type(law).name)
         self.block = threads_per_block(mesh.layout.tile)
         self.groups_used = collections.Counter()
         self._capacity = None
@@ -113,7 +138,7 @@ class Launcher:
         BarrierTimeout
             If a realisation's blocks did not meet at a barrier.
         """
-        with LAUNCHES:
+        with launching():
             arguments = list(self.arguments("minimise", slots, state, STEPS_PER_LAUNCH if nsteps is None else nsteps))
             G = self.groups_for(len(slots), arguments)
             arguments[1] = arguments[1]._replace(groups=G)
@@ -130,17 +155,17 @@ class Launcher:
 
     def per_tile(self, name, slots, state, update_wells=True):
         """Launch kernel ``name`` with one block per (slot, tile)."""
-        with LAUNCHES:
+        with launching():
             getattr(self.kernels, name)[len(slots) * self.mesh.layout.ntile, self.block](
                 *self.arguments(name, slots, state, update_wells=update_wells))
 
     def per_slot(self, name, slots, state, *extra):
         """Launch kernel ``name`` with one block per slot."""
-        with LAUNCHES:
+        with launching():
             getattr(self.kernels, name)[len(slots), self.block](*self.arguments(name, slots, state, extra=extra))
 
     def per_item(self, name, slot, count, state, *extra):
         """Launch kernel ``name`` for ``count`` items of ``slot`` (one thread each)."""
-        with LAUNCHES:
+        with launching():
             getattr(self.kernels, name)[max(1, -(-count // self.block)), self.block](
                 *self.arguments(name, [slot], state, extra=extra))
