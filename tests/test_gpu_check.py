@@ -92,7 +92,7 @@ def test_the_smoke_mode_runs_every_part_with_qdldl_from_the_carried_wheel(tmp_pa
     summary = (out / "summary.txt").read_text()
     assert status == 0, summary + (out / "gpu.log").read_text()[-4000:]
     files = [p for p in out.rglob("*") if p.is_file()]
-    assert sorted(p.name for p in files) == ["gpu.log", "results.jsonl", "rest.tar.gz", "summary.txt"]
+    assert sorted(p.name for p in files) == ["gpu.log", "rest.tar.gz", "results.jsonl", "summary.txt"]
     assert "FAILED" not in summary and "MISSING" not in summary and "ERROR" not in summary
     last = summary.strip().splitlines()[-2]  # the parts, then the wall seconds
     assert re.fullmatch(", ".join(rf"{part} \d+ s" for part in PARTS), last.removeprefix("parts: ")), last
