@@ -111,9 +111,26 @@ def host():
             "numpy_simd": [name for name in __cpu_dispatch__ if __cpu_features__.get(name)]}
 
 
-def segments(text):
-    """The arithmetic segments stored in a run file's ``arithmetic`` attribute (JSON list; [] if absent)."""
-    return json.loads(text) if text else []
+def segments(text, path="the run file"):
+    """The arithmetic segments stored in a run file's ``arithmetic`` attribute (JSON list; [] if absent).
+
+    Raises
+    ------
+    stickslip.h5io.FileFormatError
+        If the attribute is not a JSON list of objects (the message names ``path``).
+    """
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", "replace")
+    if not isinstance(text, str):
+        raise FileFormatError(f"{path}: attribute 'arithmetic' is a {type(text).__name__}, expected JSON text")
+    try:
+        found = json.loads(text) if text else []
+    except ValueError as error:
+        raise FileFormatError(f"{path}: attribute 'arithmetic' is not JSON ({error})") from None
+    if not isinstance(found, list) or not all(isinstance(item, dict) for item in found):
+        raise FileFormatError(f"{path}: attribute 'arithmetic' is {text[:80]!r}, expected a JSON list of objects "
+                              "(one per segment of arithmetic)")
+    return found
 
 
 def differences(stored, current):
@@ -123,7 +140,7 @@ def differences(stored, current):
             and stored.get(name) != current.get(name)]
 
 
-def check_resume(path, stored_text, nstored, allow=None):
+def check_resume(path, stored_text, nstored, allow=None, extra=None):
     """Check that a run can resume under this process's arithmetic; return the attribute to store.
 
     Parameters
@@ -137,6 +154,9 @@ def check_resume(path, stored_text, nstored, allow=None):
         Increments stored: a new segment would hold from this one.
     allow : bool, optional
         Continue under another arithmetic (default: :data:`CONTINUE_VARIABLE` is ``1``).
+    extra : Mapping[str, object], optional
+        What else decides the run's bits beside :func:`decisive` (a backend's device:
+        :func:`stickslip.fem.backends.backend_arithmetic`), compared as well.
 
     Returns
     -------
@@ -150,8 +170,8 @@ def check_resume(path, stored_text, nstored, allow=None):
         and how to continue anyway.
     """
     allow = os.environ.get(CONTINUE_VARIABLE) == "1" if allow is None else allow
-    stored = segments(stored_text)
-    current = decisive()
+    stored = segments(stored_text, path)
+    current = {**decisive(), **(extra or {})}
     changed = differences(stored[-1] if stored else {}, current)
     if not changed:
         return None

@@ -19,9 +19,19 @@ Tables (event lists, per-increment observables) are stored as a group with one
 
 What keeps outputs safe (atomic renames, locks, free space, the write guard through which
 :func:`open_file` writes a new file) is :mod:`stickslip.output_safety`.
+
+Files are not trusted: before a read allocates anything, :func:`read_array` checks the size the file
+declares against what it stores (a dataset cannot hold more numbers than its chunks, compressed at most
+:data:`MAX_EXPANSION` to one) and against a memory budget (:func:`read_budget`: half of what this process
+can still allocate, at most ``STICKSLIP_READ_LIMIT_MIB``), and reads large selections in blocks; a file
+whose HDF5 metadata fail their checksums raises :class:`CorruptFileError` naming it wherever it is read
+(:func:`open_file`). Each is one line naming the file and the dataset.
 """
 
 import json
+import math
+import os
+import resource
 import time
 from pathlib import Path
 
@@ -33,7 +43,8 @@ from .output_safety.errors import OutputError
 from .output_safety.write_guard import WriteGuard
 
 __all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs", "copy_file",
-           "FileFormatError", "UnreadableFileError", "CorruptFileError"]
+           "attribute", "read_budget", "FileFormatError", "UnreadableFileError", "CorruptFileError", "ReadBudgetError",
+           "READ_LIMIT_VARIABLE", "MAX_EXPANSION"]
 
 LIBVER = ("v110", "v110")
 
@@ -46,8 +57,24 @@ _CHECKSUMMED_KINDS = "biufcS"
 #: Reads of a dataset of a file being written (SWMR) before a failed checksum counts as damage.
 _SWMR_READ_ATTEMPTS = 4
 
-#: Bytes per block in which :func:`copy_file` copies a dataset (bounded memory).
-_COPY_BLOCK_BYTES = 64 * 2**20
+#: Bytes per block in which :func:`copy_file` copies and :func:`read_array` reads a dataset (bounded memory).
+_BLOCK_BYTES = 64 * 2**20
+
+#: Environment variable: the most one read of a dataset may allocate [MiB] (below the default budget).
+READ_LIMIT_VARIABLE = "STICKSLIP_READ_LIMIT_MIB"
+
+#: The most a compressed dataset can expand on reading (deflate's limit is 1032 to 1; lzf's and szip's are lower).
+MAX_EXPANSION = 1100
+
+#: HDF5 filters that compress (their data may expand up to :data:`MAX_EXPANSION`: deflate, szip, n-bit,
+#: scale-offset, lzf) and those that do not (shuffle, fletcher32); a dataset with another filter is not checked
+#: against its storage.
+_COMPRESSING = {h5py.h5z.FILTER_DEFLATE, h5py.h5z.FILTER_SZIP, h5py.h5z.FILTER_NBIT, h5py.h5z.FILTER_SCALEOFFSET,
+                32000}
+_KEEPING = {h5py.h5z.FILTER_SHUFFLE, h5py.h5z.FILTER_FLETCHER32}
+
+#: Bytes counted per element of a variable-length dataset (a Python object and its text).
+_OBJECT_BYTES = 64
 
 
 class FileFormatError(ValueError):
@@ -59,7 +86,139 @@ class UnreadableFileError(FileFormatError):
 
 
 class CorruptFileError(FileFormatError):
-    """Stored data fails its checksum or cannot be decompressed: the file is damaged."""
+    """Stored data fails its checksum or cannot be decompressed, or the file declares more than it stores: it is
+    damaged."""
+
+
+class ReadBudgetError(FileFormatError):
+    """Reading a dataset would take more memory than the budget of one read (:func:`read_budget`)."""
+
+
+def _meminfo(field):
+    """A field of /proc/meminfo [B] (None where there is none)."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as info:
+            for line in info:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return None
+
+
+def _own(field):
+    """A field of /proc/self/status [B] (0 where there is none)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 0
+
+
+def read_budget():
+    """The most one read of a dataset may allocate [B]: half of what this process can still allocate.
+
+    That is the least of the memory available (``MemAvailable``), the room left under the process's
+    address-space and data limits (``ulimit -v``, ``ulimit -d``), and ``STICKSLIP_READ_LIMIT_MIB``
+    (:data:`READ_LIMIT_VARIABLE`) if set; half of it, so that what the reader builds from the data (a
+    table, a copy) fits too.
+
+    Returns
+    -------
+    float
+        [B]; ``inf`` where nothing limits it.
+    """
+    room = [_meminfo("MemAvailable")]
+    for limit, used in ((resource.RLIMIT_AS, "VmSize"), (resource.RLIMIT_DATA, "VmData")):
+        soft = resource.getrlimit(limit)[0]
+        if soft != resource.RLIM_INFINITY:
+            room.append(max(0, soft - _own(used)))
+    budget = 0.5 * min((r for r in room if r is not None), default=math.inf)
+    capped = os.environ.get(READ_LIMIT_VARIABLE)
+    if capped:
+        try:
+            budget = min(budget, float(capped) * 2**20)
+        except ValueError:
+            raise ReadBudgetError(f"{READ_LIMIT_VARIABLE}={capped!r}: expected a number of MiB") from None
+    return budget
+
+
+def _selected_shape(shape, selection):
+    """The shape of ``dataset[selection]`` for a selection of integers and slices (else the whole shape)."""
+    items = selection if isinstance(selection, tuple) else (selection,)
+    if len(items) > len(shape) or any(not isinstance(item, (slice, int, np.integer)) for item in items):
+        return tuple(shape)
+    out = [len(range(*item.indices(n))) for item, n in zip(items, shape) if isinstance(item, slice)]
+    return tuple(out) + tuple(shape[len(items):])
+
+
+def _size(nbytes):
+    """``nbytes`` as a short text (B, KiB, MiB, GiB)."""
+    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if nbytes >= scale:
+            return f"{nbytes / scale:.3g} {unit}"
+    return f"{nbytes:.0f} B"
+
+
+def _check_size(dataset, shape):
+    """Raise unless reading ``shape`` of ``dataset`` is consistent with what the file stores and fits the budget."""
+    itemsize = _OBJECT_BYTES if dataset.dtype.kind == "O" else dataset.dtype.itemsize
+    nbytes = float(np.prod(shape, dtype=float)) * itemsize
+    if nbytes <= _BLOCK_BYTES:  # small: allocated at once whatever the file says
+        return
+    name = f"{dataset.file.filename}: dataset {dataset.name}"
+    plist = dataset.id.get_create_plist()
+    filters = {plist.get_filter(i)[0] for i in range(plist.get_nfilters())}
+    if dataset.dtype.kind != "O" and filters <= _COMPRESSING | _KEEPING:
+        stored = dataset.id.get_storage_size()
+        expansion = MAX_EXPANSION if filters & _COMPRESSING else 1
+        chunk = float(np.prod(dataset.chunks, dtype=float)) * itemsize if dataset.chunks else 0.0
+        if nbytes > stored * expansion + chunk:
+            raise CorruptFileError(f"{name} declares {shape} {dataset.dtype} ({_size(nbytes)}) but stores "
+                                   f"{_size(stored)}{' compressed' if expansion > 1 else ''}: the file is damaged or "
+                                   "not what it claims; remake it (rerun the job that wrote it)")
+    budget = read_budget()
+    if nbytes > budget:
+        raise ReadBudgetError(f"{name}: reading {shape} {dataset.dtype} would take {_size(nbytes)}, beyond the "
+                              f"memory budget of one read ({_size(budget)}: half of what this process can still "
+                              f"allocate, or {READ_LIMIT_VARIABLE})")
+
+
+def _blocks(rows, row_bytes, chunk_rows):
+    """Row ranges ``(start, stop)`` of at most :data:`_BLOCK_BYTES`, whole chunks each, covering ``rows`` rows."""
+    step = max(1, _BLOCK_BYTES // max(1, row_bytes) // chunk_rows) * chunk_rows
+    return [(start, min(start + step, rows)) for start in range(0, rows, step)]
+
+
+class _CheckedFile(h5py.File):
+    """An HDF5 file opened for reading whose failures inside a ``with`` block name it: metadata that fail their
+    checksums or cannot be parsed (h5py's KeyError, RuntimeError, OSError, ...) become :class:`CorruptFileError`."""
+
+    def __init__(self, path, *args, **kwargs):
+        super().__init__(path, *args, **kwargs)
+        self._path = Path(path)
+
+    def __exit__(self, kind, error, trace):
+        super().__exit__(kind, error, trace)
+        if isinstance(error, _HDF5_FAILURES) and not isinstance(error, FileFormatError) and _raised_by_hdf5(trace):
+            raise CorruptFileError(f"{self._path}: damaged or not a file of the expected layout: HDF5 cannot read "
+                                   f"it ({type(error).__name__}: {str(error).strip(chr(39))}); remake it (rerun the "
+                                   "job that wrote it)") from error
+
+
+#: What h5py raises for metadata it cannot read (a failed checksum, a missing or malformed object).
+_HDF5_FAILURES = (KeyError, RuntimeError, OSError, ValueError, TypeError)
+
+
+def _raised_by_hdf5(trace):
+    """Whether the innermost frame of a traceback is h5py's (its Python or its compiled modules)."""
+    while trace.tb_next is not None:
+        trace = trace.tb_next
+    filename = trace.tb_frame.f_code.co_filename.replace(os.sep, "/")
+    return "/h5py/" in filename or filename.startswith("h5py/")
 
 
 def open_file(path, mode="r"):
@@ -98,6 +257,9 @@ def open_file(path, mode="r"):
         If a file to read does not exist.
     UnreadableFileError
         If it is not a readable HDF5 file.
+    CorruptFileError
+        From the end of a ``with`` block of a file opened to read (``"r"``) in which HDF5 failed to read
+        it (damaged metadata, an object the layout needs that is not there).
     """
     path = Path(path)
     if mode not in ("r", "r+", "w"):
@@ -108,11 +270,11 @@ def open_file(path, mode="r"):
         return _GuardedFile(WriteGuard(path))
     reading = {"locking": False} if mode == "r" else {"libver": LIBVER}
     try:
-        return h5py.File(path, mode, **reading)
+        return _CheckedFile(path, "r", **reading) if mode == "r" else h5py.File(path, mode, **reading)
     except OSError as error:
         if mode == "r" and _OPEN_FOR_WRITE in str(error):
             try:
-                return h5py.File(path, "r", swmr=True, **reading)
+                return _CheckedFile(path, "r", swmr=True, **reading)
             except OSError:
                 pass
         raise UnreadableFileError(f"{path}: not a readable HDF5 file ({error})") from error
@@ -193,10 +355,35 @@ def read_array(dataset, selection=()):
     ------
     CorruptFileError
         If HDF5 cannot read the data: a checksum (:func:`write_dataset`) or the
-        decompression of a chunk failed. The message names the file and dataset.
+        decompression of a chunk failed; or the dataset declares more data than the
+        file stores. The message names the file and dataset.
         In a file being written (SWMR), where a chunk may be read while its writer
         rewrites it, the read is tried :data:`_SWMR_READ_ATTEMPTS` times first.
+    ReadBudgetError
+        If the selection would take more memory than :func:`read_budget`.
+
+    Notes
+    -----
+    A selection of more than 64 MiB along the first axis is read in blocks of whole chunks into one
+    array (no temporary of its size).
     """
+    shape = _selected_shape(dataset.shape, selection)
+    _check_size(dataset, shape)
+    items = selection if isinstance(selection, tuple) else (selection,)
+    row_bytes = dataset.dtype.itemsize * int(np.prod(shape[1:], dtype=np.int64)) if shape else 0
+    whole_rows = items in ((), (slice(None),)) or (len(items) == 1 and isinstance(items[0], slice)
+                                                    and items[0].step in (None, 1))
+    if shape and whole_rows and dataset.dtype.kind != "O" and shape[0] * row_bytes > _BLOCK_BYTES:
+        first = items[0].indices(dataset.shape[0])[0] if items else 0
+        out = np.empty(shape, dtype=dataset.dtype)
+        for start, stop in _blocks(shape[0], row_bytes, dataset.chunks[0] if dataset.chunks else 1):
+            out[start:stop] = _read(dataset, slice(first + start, first + stop))
+        return out
+    return _read(dataset, selection)
+
+
+def _read(dataset, selection):
+    """``dataset[selection]``, tried again in a file being written; raises CorruptFileError (:func:`read_array`)."""
     attempts = _SWMR_READ_ATTEMPTS if dataset.file.swmr_mode else 1
     for attempt in range(1, attempts + 1):
         try:
@@ -231,6 +418,67 @@ def read_datasets(path):
     with h5py.File(path, "r") as file:
         file.visititems(keep)
     return found
+
+
+#: What :func:`attribute` accepts of each kind, for its messages.
+_ATTRIBUTE_KINDS = {"int": "an integer", "float": "a finite number", "str": "text", "bool": "true or false",
+                    "json": "JSON text"}
+
+
+def attribute(obj, name, kind, default=None, *, required=True):
+    """An attribute of the right kind, or a one-line FileFormatError naming the file, the object and the attribute.
+
+    Parameters
+    ----------
+    obj : h5py.Group or h5py.Dataset
+    name : str
+    kind : {"int", "float", "str", "bool", "json"}
+        ``int``: an integer (an integral float too); ``float``: a finite real number; ``str``: text (bytes
+        decoded as UTF-8); ``bool``: a boolean (or 0 / 1); ``json``: JSON text, returned decoded.
+    default : object, optional
+        Returned if the attribute is absent and not ``required``.
+    required : bool, optional
+
+    Returns
+    -------
+    int, float, str, bool or the decoded JSON value
+
+    Raises
+    ------
+    FileFormatError
+        If the attribute is absent (and required) or not of that kind.
+    """
+    where = f"{obj.file.filename}: attribute '{name}'" + ("" if obj.name == "/" else f" of {obj.name}")
+    if name not in obj.attrs:
+        if required:
+            raise FileFormatError(f"{where} is missing")
+        return default
+    value = obj.attrs[name]
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, bytes):
+        try:
+            value = value.decode("utf-8")
+        except UnicodeDecodeError:
+            raise FileFormatError(f"{where} is not UTF-8 text") from None
+    found = value.item() if isinstance(value, np.generic) else value
+    if kind == "str" and isinstance(found, str):
+        return found
+    if kind == "json" and isinstance(found, str):
+        try:
+            return json.loads(found)
+        except ValueError as error:
+            raise FileFormatError(f"{where} is not JSON ({error})") from None
+    if kind == "bool" and (isinstance(found, bool) or (isinstance(found, int) and found in (0, 1))):
+        return bool(found)
+    if kind == "int" and not isinstance(found, bool):
+        if isinstance(found, int) or (isinstance(found, float) and found.is_integer()):
+            return int(found)
+    if kind == "float" and isinstance(found, (int, float)) and not isinstance(found, bool) and math.isfinite(found):
+        return float(found)
+    shown = np.array2string(found, threshold=6) if isinstance(found, np.ndarray) else repr(found)
+    shown = " ".join(shown.split())
+    raise FileFormatError(f"{where} is {shown[:80]}, expected {_ATTRIBUTE_KINDS[kind]}")
 
 
 def write_attrs(obj, attrs):
@@ -291,17 +539,35 @@ def read_table(group, name, rows=None):
     Raises
     ------
     FileFormatError
-        If the table is missing or malformed.
+        If the table is missing or malformed: its ``columns`` attribute is not a JSON list of names, a
+        column is not a 1-D dataset, or the columns have other lengths (fewer than ``rows``).
     """
-    if name not in group or "columns" not in group[name].attrs:
+    where = f"{group.file.filename}: table '{name}'"
+    if name not in group or not isinstance(group[name], h5py.Group) or "columns" not in group[name].attrs:
         raise FileFormatError(f"{group.file.filename}: no table '{name}' in {group.name}")
     sub = group[name]
-    columns = json.loads(sub.attrs["columns"])
+    columns = attribute(sub, "columns", "json")
+    if not isinstance(columns, list) or not all(isinstance(column, str) for column in columns):
+        raise FileFormatError(f"{where}: attribute 'columns' is not a JSON list of column names")
+    lengths = {}
+    for column in columns:
+        dataset = sub.get(column)
+        if not isinstance(dataset, h5py.Dataset) or dataset.ndim != 1:
+            found = "missing" if dataset is None else f"of shape {getattr(dataset, 'shape', 'a group')}"
+            raise FileFormatError(f"{where}: column '{column}' is {found}, expected a 1-D dataset")
+        lengths[column] = dataset.shape[0]
+    expected = rows if rows is not None else max(lengths.values(), default=0)
+    short = {column: n for column, n in lengths.items() if n < expected or (rows is None and n != expected)}
+    if short:
+        column, n = next(iter(short.items()))
+        raise FileFormatError(f"{where}: column '{column}' has {n} rows, expected {expected}"
+                              f"{' (the rows the file says it stores)' if rows is not None else ''}")
     data = {}
     for column in columns:
         values = read_array(sub[column], slice(None, rows))
         if values.dtype.kind in "OS":
-            values = np.asarray([v.decode() if isinstance(v, bytes) else v for v in values], dtype=object)
+            values = np.asarray([v.decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values],
+                                dtype=object)
         data[column] = values
     return pd.DataFrame(data, columns=columns)
 
@@ -339,11 +605,9 @@ def copy_file(source, target, rows):
             if not shape:
                 out[()] = read_array(obj)
             elif shape[0]:
-                chunk = obj.chunks[0] if obj.chunks else 1
-                row_bytes = max(1, obj.dtype.itemsize * int(np.prod(shape[1:])))
-                step = max(1, _COPY_BLOCK_BYTES // row_bytes // chunk) * chunk
-                for start in range(0, shape[0], step):
-                    out[start:start + step] = read_array(obj, slice(start, min(start + step, shape[0])))
+                row_bytes = obj.dtype.itemsize * int(np.prod(shape[1:]))
+                for start, stop in _blocks(shape[0], row_bytes, obj.chunks[0] if obj.chunks else 1):
+                    out[start:stop] = read_array(obj, slice(start, stop))
             copy_attrs(obj, out)
 
     copy_group(source, target)

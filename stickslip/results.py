@@ -189,17 +189,34 @@ class StudyResults:
         """The figures with the run that drew them (:func:`stickslip.provenance.query.figures`)."""
         return query.figures(self.database)
 
-    def sql(self, statement):
+    def sql(self, statement, *, time_limit=query.TIME_LIMIT_S, max_rows=query.MAX_ROWS,
+            memory_limit_mib=query.MEMORY_LIMIT_MIB):
         """One SQL query on a read-only connection (:func:`stickslip.provenance.query.sql`; ``db sql``).
 
         Tables and views: docs/database.md.
+
+        Parameters
+        ----------
+        statement : str
+        time_limit : float or None
+            [s]; None or 0: no limit (``db sql --time-limit``).
+        max_rows : int or None
+            None or 0: no limit (``--max-rows``).
+        memory_limit_mib : float or None
+            SQLite's memory and the rows fetched [MiB]; None or 0: no limit (``--memory-limit``).
 
         Returns
         -------
         pandas.DataFrame
             Columns named as the vocabulary's are typed and have their units in ``attrs["units"]``.
+
+        Raises
+        ------
+        stickslip.provenance.query.QueryError
+            A ``ValueError``: bad SQL, a write, a bound reached or a bound that is not a number >= 0.
         """
-        return query.sql(statement, self.database)
+        return query.sql(statement, self.database, time_limit=time_limit, max_rows=max_rows,
+                         memory_limit_mib=memory_limit_mib)
 
     def open_run(self, run_id):
         """Open one simulation of the study by its run id (:func:`stickslip.runs.open_run`).

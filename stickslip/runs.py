@@ -29,7 +29,7 @@ from .experiment.analysis import ExperimentEventsParams, analyse_record, experim
 from .experiment.timeseries import read_timeseries, read_truth
 from .formats.fem_run import RunFile, read_increments, read_run_attrs
 from .errors import IncrementError
-from .h5io import FileFormatError, open_file
+from .h5io import FileFormatError, attribute, open_file
 from .output_safety.overwrite import root_attributes
 from .params import parse_params
 from .vocabulary import with_units
@@ -76,6 +76,10 @@ class RunState:
     well : numpy.ndarray
         int64 [n_interfaces, N, 4]: the well each of those Gauss points is in, counted from the start of
         its block's yield-strain sequence.
+    further : dict[str, numpy.ndarray]
+        The producer's further state of that increment (``fem`` with junction aging: ``junction_depth``
+        float64 [n_interfaces * N] [G eps0^2 h^2], ``junction_well`` int64 [n_interfaces * N], -1: no
+        junction); empty for a run without it.
     """
 
     increment: int
@@ -87,6 +91,7 @@ class RunState:
     eps: np.ndarray
     sig: np.ndarray
     well: np.ndarray
+    further: dict = dataclasses.field(default_factory=dict)
 
 
 class FemRun(_Run):
@@ -190,10 +195,11 @@ class FemRun(_Run):
         """
         increment = self._stored(increment)
         with open_file(self.path) as file:
-            u, target, lever_target, t = RunFile(file).state(increment)
+            u, target, lever_target, t, *further = RunFile(file).state(increment)
         fields = self._replay.interface_state(increment)
         return RunState(increment=int(increment), t=t, u=u, displacement=u[self.mesh.dofs], target=target,
-                        lever_target=lever_target, eps=fields["eps"], sig=fields["sig"], well=fields["well"])
+                        lever_target=lever_target, eps=fields["eps"], sig=fields["sig"], well=fields["well"],
+                        further=dict(*further))
 
     def events(self):
         """The tables of the ``numerical-events`` analysis (what the workflow writes for this run).
@@ -249,7 +255,7 @@ class FemRun(_Run):
         stickslip.errors.IncrementError
             An ``IndexError`` (and a ``FileFormatError``): the increment is not stored.
         stickslip.h5io.FileFormatError
-            If the increment is not a kick, or the solver cannot replay events.
+            If the increment is not a stored kick, or the solver cannot replay events (``fem``: a thermal run).
         """
         failures = self._replay.failures(self._stored(increment))
         return with_units(failures.rename(columns={"a": "interface", "direction": "hop_direction"}))
@@ -408,9 +414,8 @@ def open_run(path):
     """
     path = Path(path)
     with open_file(path) as file:
-        found = file.attrs.get("format", TimeseriesRun.format)
-        version = int(file.attrs.get("format_version", -1))
-    found = found.decode() if isinstance(found, bytes) else str(found)
+        found = attribute(file, "format", "str", TimeseriesRun.format, required=False)
+        version = attribute(file, "format_version", "int", -1, required=False)
     if found not in READERS:
         expected = ", ".join(f"{name} version {formats.get_format(name).version}" for name in READERS)
         raise FileFormatError(f"{path}: a {found} file version {version}, expected a simulation file: {expected}")

@@ -6,11 +6,15 @@ by the one rule of every command that writes a file (:func:`stickslip.output_saf
 the same run is resumed (``fem``) or written again, another run is refused unless ``overwrite``.
 """
 
+import numbers
+
+import numpy as np
+
 from . import registry
 from .numba_options import set_num_threads
 from .output_safety.atomic import check_output
 from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
-from .params import params_to_dict, parse_params
+from .params import ParameterError, params_to_dict, parse_params
 
 __all__ = ["run_identity", "run_solver"]
 
@@ -50,11 +54,16 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     stickslip.registry.PluginError
         If there is no such solver.
     stickslip.params.ParameterError
-        For an unknown parameter or a bad value (a ``ValueError`` naming the parameter), or parameters this
-        machine cannot run (the solver's ``preflight``: a GPU backend without a GPU), before any file is touched.
+        For an unknown parameter or a bad value (a ``ValueError`` naming the parameter; ``threads`` and
+        ``overwrite`` of another type too), or parameters this machine cannot run (the solver's ``preflight``: a
+        GPU backend without a GPU), before any file is touched.
     stickslip.output_safety.errors.OutputError
         If ``output`` cannot be written, or holds another run and ``overwrite`` is false.
     """
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral) or threads < 1:
+        raise ParameterError(f"parameter 'threads': expected an integer >= 1, got {threads!r}")
+    if not isinstance(overwrite, (bool, np.bool_)):
+        raise ParameterError(f"parameter 'overwrite': expected True or False, got {overwrite!r}")
     plugin = registry.get("solver", solver)
     params = parse_params(plugin.params, values, owner=f"solver '{plugin.name}'")
     if plugin.preflight is not None:

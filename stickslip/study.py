@@ -41,8 +41,8 @@ from .params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import record_path
 
-__all__ = ["RESULTS", "PATHS", "study_name", "SimulationJob", "AnalysisJob", "FigureJob", "Study", "plugin_sections",
-           "normalise", "check_sweeps"]
+__all__ = ["RESULTS", "PATHS", "study_name", "check_study_name", "SimulationJob", "AnalysisJob", "FigureJob", "Study",
+           "plugin_sections", "normalise", "check_sweeps"]
 
 #: Directory of the studies' results trees (relative to the workflow's working directory).
 RESULTS = "results"
@@ -82,8 +82,20 @@ def study_name(config, configfiles=()):
         If the name is not a valid path component.
     """
     name = config.get("study") or (Path(configfiles[-1]).stem if configfiles else "default")
+    return check_study_name(name, "config key study")
+
+
+def check_study_name(name, what):
+    """``name`` as a study name: a path component of ``results/`` (never ``..``, never a path); else ParameterError.
+
+    Parameters
+    ----------
+    name : object
+    what : str
+        Where the name comes from, for the message (``config key study``, ``--study``).
+    """
     if not _STUDY_NAME.match(str(name)):
-        raise ParameterError(f"config key study: expected a name matching {_STUDY_NAME.pattern} "
+        raise ParameterError(f"{what}: expected a name matching {_STUDY_NAME.pattern} "
                              f"(it is a directory under {RESULTS}/), got {name!r}")
     return str(name)
 

@@ -241,3 +241,16 @@ def kill_when_stored(command, watched, increments, signum, timeout=600):
     process.send_signal(signum)
     _, err = process.communicate(timeout=120)
     return process.returncode, err, stored
+
+
+def time_to_stop(process, signum, within, what):
+    """Send ``signum`` to ``process`` and return the seconds it took to end; fail if it runs ``within`` s more."""
+    process.send_signal(signum)
+    start = time.monotonic()
+    try:
+        process.wait(timeout=within)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+        pytest.fail(f"{what} went on for {within} s after signal {signum}")
+    return time.monotonic() - start

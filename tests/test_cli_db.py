@@ -11,6 +11,7 @@ from contextlib import redirect_stdout
 
 import pandas as pd
 import pytest
+from conftest import time_to_stop
 
 from stickslip.cli import main
 
@@ -136,15 +137,7 @@ def test_db_sql_stops_at_ctrl_c_within_a_second(toy_results):
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(4.0)  # started, and inside SQLite (the count takes minutes)
     assert process.poll() is None
-    process.send_signal(signal.SIGINT)
-    start = time.monotonic()
-    try:
-        process.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.wait()
-        pytest.fail("db sql went on for 10 s after Ctrl-C")
-    assert time.monotonic() - start < 1.5 and process.returncode == 130
+    assert time_to_stop(process, signal.SIGINT, 10, "db sql") < 1.5 and process.returncode == 130
 
 
 def test_a_mistyped_regime_is_refused_not_answered_with_no_rows(toy_results, capsys):

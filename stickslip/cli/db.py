@@ -11,6 +11,7 @@ any folder below it, :mod:`stickslip.workdir`): ``--study NAME`` chooses it (def
 are those of ``stickslip.study(...).runs/events`` (:mod:`stickslip.provenance.filters`).
 """
 
+import argparse
 import os
 import sys
 from pathlib import Path
@@ -38,8 +39,18 @@ EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regi
                  "interface", "slip", "dmu", "dmu_sig0", "multi", "time", "t", "increment")
 
 
+def _study(name):
+    """``--study``: a study's name, a directory under results/ (``..`` or a path would leave it)."""
+    from ..study import check_study_name
+
+    try:
+        return check_study_name(name, "a study name")
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def _database_options(parser):
-    parser.add_argument("--study", default="default",
+    parser.add_argument("--study", default="default", type=_study,
                         help="study whose database to use: results/STUDY/stickslip.sqlite in the workflow directory "
                              "(default: default)")
     parser.add_argument("--workdir", type=Path, default=None, metavar="DIR",
@@ -163,18 +174,42 @@ def _print(frame, args, columns=None):
     return 0
 
 
+#: Rows formatted and written at a time: the text of a result is never held whole.
+PIECE = 10_000
+
+
+def _text_of_blobs(frame):
+    """``frame`` with every bytes value (an SQL blob) as its hexadecimal text (JSON and CSV have no bytes)."""
+    blobs = [c for c in frame.columns if frame[c].dtype == object and frame[c].map(type).eq(bytes).any()]
+    if not blobs:
+        return frame
+    frame = frame.copy()
+    for column in blobs:
+        frame[column] = frame[column].map(lambda v: v.hex() if isinstance(v, bytes) else v)
+    return frame
+
+
 def _write(frame, args, columns):
+    """Write ``frame`` in the format of ``args``, :data:`PIECE` rows at a time (blobs as hexadecimal text)."""
     if args.format == "table" and columns is not None and not args.all_columns:
         frame = frame[[c for c in columns if c in frame.columns]]
-    if args.format == "csv":
-        frame.to_csv(sys.stdout, index=False)
-    elif args.format == "json":
-        sys.stdout.write(frame.to_json(orient="records", indent=1, date_format="iso") + "\n")
-    elif frame.empty:
+    if frame.empty and args.format == "table":
         print("(no rows)")
-    else:
-        with pd.option_context("display.max_rows", None, "display.max_columns", None, "display.width", 200):
-            print(frame.to_string(index=False))
+        return
+    if args.format == "json":
+        sys.stdout.write("[")
+    for start in range(0, max(len(frame), 1), PIECE):
+        piece = _text_of_blobs(frame.iloc[start:start + PIECE])
+        if args.format == "csv":
+            piece.to_csv(sys.stdout, index=False, header=start == 0)
+        elif args.format == "json":
+            records = piece.to_json(orient="records", indent=1, date_format="iso")[1:-1].strip("\n")
+            sys.stdout.write(("," if start and records else "") + ("\n" + records if records else ""))
+        else:
+            with pd.option_context("display.max_rows", None, "display.max_columns", None, "display.width", 200):
+                print(piece.to_string(index=False))
+    if args.format == "json":
+        sys.stdout.write("\n]\n" if len(frame) else "]\n")
 
 
 def _query(args, name, columns=None, *positional, **filters):

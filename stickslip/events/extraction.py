@@ -45,13 +45,15 @@ TANGENT_FRACTION = 0.95
 _S_COLUMN = re.compile(r"^S_a(\d+)$")
 
 
-def interfaces_in(increments):
+def interfaces_in(increments, source="increment table"):
     """Return the interface numbers ``a = 1 ... n`` present in an increment table.
 
     Parameters
     ----------
     increments : pandas.DataFrame
         Table with columns ``S_a<a>`` (one per interface).
+    source : str, optional
+        Name of the table's origin, for error messages.
 
     Returns
     -------
@@ -60,7 +62,7 @@ def interfaces_in(increments):
     """
     found = sorted(int(m.group(1)) for c in increments.columns if (m := _S_COLUMN.match(str(c))))
     if not found:
-        raise FileFormatError("increment table: no interface columns 'S_a<a>'")
+        raise FileFormatError(f"{source}: increment table has no interface columns 'S_a<a>'")
     return found
 
 
@@ -147,7 +149,7 @@ def classify_increments(increments, N, *, source="increment table"):
         ("initial" for increment 0, "load", "micro", "single" or "multi") and ``steady`` (bool: at or after the steady
         state).
     """
-    interfaces = interfaces_in(increments)
+    interfaces = interfaces_in(increments, source)
     _check_table(increments, interfaces, source)
     out = pd.DataFrame({c: increments[c].to_numpy() for c in ("increment", "kick", "gamma", "epsd", "sigd")})
     out["kick"] = out["kick"].astype(bool)

@@ -45,6 +45,7 @@ and ``interfaces`` (one row per interface), see :mod:`stickslip.solvers.lever`.
 import dataclasses
 import sys
 
+import h5py
 import numpy as np
 
 from .. import formats, h5io
@@ -137,9 +138,10 @@ def _fail(source, item, expected):
     raise h5io.FileFormatError(f"{source}: '{item}' {expected}")
 
 
-def _plain(value):
-    """A numpy scalar as the Python number it holds (shown ``39.6``, not ``np.float64(39.6)``)."""
-    return value.item() if isinstance(value, np.generic) else value
+def _shown(value):
+    """An attribute's value on one line: a numpy scalar as the number it holds (``39.6``, not ``np.float64(39.6)``)."""
+    value = value.item() if isinstance(value, np.generic) else value
+    return " ".join(repr(value).split())[:80]
 
 
 def _check_times(source, name, times):
@@ -283,31 +285,32 @@ def _read_record(f, source):
     for name in _DATASETS:
         if name not in f:
             _fail(source, name, "is missing (required dataset)")
-        unit = f[name].attrs.get("unit", f[name].attrs.get("units"))
-        unit = unit.decode() if isinstance(unit, bytes) else unit
+        if not isinstance(f[name], h5py.Dataset):
+            _fail(source, name, "must be a dataset, got a group")
+        units = [h5io.attribute(f[name], key, "str", required=False) for key in ("unit", "units")]
+        unit = units[0] if units[0] is not None else units[1]
         if unit is not None and unit != _UNITS[name]:
             _fail(source, name, f"is in [{unit}]; the format stores it in [{_UNITS[name]}] (convert it, or "
                                 f"import the lab's CSV with `stickslip import-csv`, which converts units)")
+        if f[name].dtype.kind not in "fiu":
+            _fail(source, name, f"must be numeric, got dtype {f[name].dtype}")
         data = h5io.read_array(f[name])
-        if data.dtype.kind not in "fiu":
-            _fail(source, name, f"must be numeric, got dtype {data.dtype}")
         values[name] = np.asarray(data, dtype=np.float64)
     for name in ("protocol",) + _INT_ATTRS + _FLOAT_ATTRS:
         if name not in f.attrs and name != "a":
             _fail(source, name, "is missing (required attribute)")
-    protocol = f.attrs["protocol"]
-    values["protocol"] = protocol.decode() if isinstance(protocol, bytes) else str(protocol)
+    values["protocol"] = h5io.attribute(f, "protocol", "str")
     if "a" not in f.attrs and values["protocol"] == "individual":
         _fail(source, "a", "is missing (required attribute of the individual protocol: the driven slab)")
     for name in _INT_ATTRS:
         value = f.attrs.get(name, 0)  # only a of a stack recording may be absent: 0
         if not (np.issubdtype(type(value), np.integer) or (isinstance(value, float) and value.is_integer())):
-            _fail(source, name, f"must be an integer, got {_plain(value)!r}")
+            _fail(source, name, f"must be an integer, got {_shown(value)}")
         values[name] = int(value)
     for name in _FLOAT_ATTRS:
         value = f.attrs[name]
         if not np.issubdtype(type(value), np.number) or np.ndim(value) != 0:
-            _fail(source, name, f"must be a number, got {_plain(value)!r}")
+            _fail(source, name, f"must be a number, got {_shown(value)}")
         values[name] = float(value)
     record = ExperimentRecord(**values)
     validate_record(record, source=source)
@@ -352,8 +355,6 @@ def describe(path):
     """
     with h5io.open_file(path) as f:
         formats.check(f, FORMAT)
-        protocol = f.attrs["protocol"]
-        seed = f.attrs.get("seed")
-        return {"protocol": protocol.decode() if isinstance(protocol, bytes) else str(protocol),
-                "n": int(f.attrs["n"]), "driven_slab": int(f.attrs.get("a", 0)),
-                "seed": None if seed is None else int(seed)}
+        return {"protocol": h5io.attribute(f, "protocol", "str"), "n": h5io.attribute(f, "n", "int"),
+                "driven_slab": h5io.attribute(f, "a", "int", 0, required=False),
+                "seed": h5io.attribute(f, "seed", "int", required=False)}

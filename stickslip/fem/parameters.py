@@ -13,9 +13,10 @@ from ..formats import fem_run
 from ..params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
+from .thermal.junctions import expected_redraws
 
 __all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "CYCLE_STRAIN", "REACH_MIN", "REACH_REGIME",
-           "REACH_MELT", "thermal_reach", "stored_params"]
+           "REACH_MELT", "CLOCK_ATTEMPTS", "REDRAWS_MAX", "thermal_reach", "stored_params"]
 
 #: Drive configurations: springs to a lever that rotates as prescribed, or a massless lever driven by a spring.
 DRIVES = ("fixed-lever", "free-lever")
@@ -40,6 +41,12 @@ REACH_REGIME = 0.025
 #: Reach at which a block eps0 below its yield strain (the unit barrier) hops within a cycle: every
 #: interface flows, and the event-driven method describes nothing (refused).
 REACH_MELT = 1.0
+#: Attempts of a thermal process in one stick-slip cycle (or hold) beyond which the clock, a double, no longer
+#: tells one attempt time from the next (2^52, its resolution): such an attempt rate is refused.
+CLOCK_ATTEMPTS = 2.0 ** 52
+#: Redraws of one junction in a stick-slip cycle (or hold) that the trap model expects
+#: (:func:`.thermal.junctions.expected_redraws`) beyond which a run would not end (hours per cycle): refused.
+REDRAWS_MAX = 1e6
 
 
 def thermal_reach(temperature, attempt_rate, drive_rate):
@@ -166,7 +173,8 @@ class FemParams:
             raise ParameterError(f"parameter 'hold_delay': {self.hold_delay:g} is used only with hold_times; expected "
                                  "hold_times (e.g. hold_times=[1e3, 1e6]) or the default 0")
         if self.temperature > 0.0:
-            _refuse_or_warn_reach(self)
+            _refuse_reach(self)
+            _refuse_beyond_clock(self, "attempt_rate", self.attempt_rate)
         if self.temperature == 0.0:
             for name in ("attempt_rate", "drive_rate", "hold_times", "hold_delay"):
                 field = self.__dataclass_fields__[name]
@@ -177,7 +185,13 @@ class FemParams:
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
-
+        if self.temperature > 0.0:  # warnings last: a refused run is one line
+            _warn_reach(self)
+            if self.junction_strengthening > 0.0 and self.junction_glass_temperature <= self.temperature:
+                warnings.warn(f"parameters 'junction_glass_temperature', 'temperature': T_g = "
+                              f"{self.junction_glass_temperature:g} <= T = {self.temperature:g}: the junctions do not "
+                              "age (their depth saturates at once) and are redrawn at a rate that does not decay "
+                              "(docs/fem.md, 'Junction aging')", ParameterWarning, stacklevel=2)
 
     def _check_junctions(self):
         if self.junction_strengthening == 0.0:
@@ -193,6 +207,8 @@ class FemParams:
             raise ParameterError(f"parameter 'junction_strengthening': law '{self.interface_law}' has a stress that "
                                  "depends on the well's width, so a junction cannot widen it at rest; expected "
                                  "interface_law 'cusp' or junction_strengthening = 0")
+        _refuse_beyond_clock(self, "junction_attempt_rate", self.junction_attempt_rate)
+        _refuse_endless_redraws(self)
 
     def _check_law(self):
         law = INTERFACE_LAWS[self.interface_law]
@@ -208,8 +224,41 @@ class FemParams:
                                  "activation; expected 0")
 
 
-def _refuse_or_warn_reach(params):
-    """Raise ParameterError if the thermal reach is outside what the method represents; warn beyond the regime."""
+def _stretch(params):
+    """The longest stretch of a thermal run's time: a stick-slip cycle or its longest hold [time], and its name."""
+    cycle = CYCLE_STRAIN / params.drive_rate
+    hold = max(params.hold_times, default=0.0)
+    if hold > cycle:
+        return hold, f"a hold of {hold:.3g} time"
+    return cycle, f"a stick-slip cycle ({CYCLE_STRAIN:g} eps0 of drive: {cycle:.3g} time)"
+
+
+def _refuse_beyond_clock(params, name, rate):
+    """Raise ParameterError if the attempt rate ``name`` makes more than :data:`CLOCK_ATTEMPTS` attempts in a stretch."""
+    stretch, what = _stretch(params)
+    if rate * stretch >= CLOCK_ATTEMPTS:
+        raise ParameterError(f"parameter '{name}': {rate:g}/time makes {rate * stretch:.3g} attempts in {what}, beyond "
+                             f"the resolution of the clock (2^52 steps of a double); expected < "
+                             f"{CLOCK_ATTEMPTS / stretch:.3g} (docs/fem.md, 'Limits of the regime')")
+
+
+def _refuse_endless_redraws(params):
+    """Raise ParameterError if the junctions would be redrawn more than :data:`REDRAWS_MAX` times in a stretch."""
+    p = params
+    stretch, what = _stretch(p)
+    redraws = expected_redraws(p.junction_attempt_rate, p.temperature, p.junction_glass_temperature, stretch)
+    if redraws > REDRAWS_MAX:
+        ratio = p.temperature / p.junction_glass_temperature
+        raise ParameterError(f"parameter 'junction_glass_temperature': {p.junction_glass_temperature:g} at temperature "
+                             f"{p.temperature:g} and junction_attempt_rate {p.junction_attempt_rate:g}/time has every "
+                             f"junction redrawn ~{redraws:.3g} times in {what} (the trap model's (nu_j t)^min(1, T/T_g), "
+                             f"T/T_g = {ratio:.3g}), beyond {REDRAWS_MAX:g}: the run would not end; expected a glass "
+                             "temperature well above the temperature or a lower junction_attempt_rate (docs/fem.md, "
+                             "'Junction aging')")
+
+
+def _refuse_reach(params):
+    """Raise ParameterError if the thermal reach is outside what the method represents."""
     p = params
     reach = thermal_reach(p.temperature, p.attempt_rate, p.drive_rate)
     cycle = f"a stick-slip cycle ({CYCLE_STRAIN:g} eps0 of drive)"
@@ -230,6 +279,13 @@ def _refuse_or_warn_reach(params):
                              f"hops at once: the interfaces flow); expected <= {REACH_MELT / log_attempts:.3g}, the "
                              f"studied regime T ln(nu t_cycle) <= {REACH_REGIME:g} at <= "
                              f"{REACH_REGIME / log_attempts:.3g} (docs/fem.md, 'Limits of the regime')")
+
+
+def _warn_reach(params):
+    """Warn if the thermal reach is beyond the regime where the studies stay."""
+    p = params
+    reach = thermal_reach(p.temperature, p.attempt_rate, p.drive_rate)
+    log_attempts = reach / p.temperature
     if reach > REACH_REGIME:
         warnings.warn(f"parameters 'temperature', 'drive_rate': thermal reach T ln(nu t_cycle) = {reach:.3g}, beyond "
                       f"the regime T ln(nu t_cycle) <= {REACH_REGIME:g} (temperature <= "

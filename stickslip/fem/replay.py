@@ -137,8 +137,13 @@ class EventReplay:
         Raises
         ------
         FileFormatError
-            If the increment is not a stored kick.
+            If the increment is not a stored kick, or the run is thermal (its events are hops, kicks at its
+            clock and junction redraws, which this replay does not redo).
         """
+        if self.params.temperature > 0.0:
+            raise FileFormatError(f"{self.path}: a thermal run (temperature = {self.params.temperature:g}); its events "
+                                  "are hops, athermal kicks and junction redraws, and failures() replays the kicks "
+                                  "of an athermal run (temperature = 0) only")
         if not 1 <= increment < self.nstored or not self._kick[increment]:
             raise FileFormatError(f"{self.path}: increment {increment} is not a stored kick increment")
         before, after = self._state(increment - 1), self._state(increment)

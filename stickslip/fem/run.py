@@ -32,6 +32,7 @@ from ..output_safety.lock import writer_lock
 from ..output_safety.overwrite import changed_values, set_aside
 from ..output_safety.space import check_free_space
 from ..params import params_to_dict
+from .backends import backend_arithmetic
 from .observables import Observer, observable_columns
 from .parameters import stored_params
 from .simulation import Simulation
@@ -95,7 +96,8 @@ def _create(path, params, mesh, backend, producer):
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
             create_file(file, _header(simulation, observer, producer), mesh, simulation.loading.response,
-                        columns + list(protocol.columns), protocol.columns, protocol.state_fields)
+                        columns + list(protocol.columns), protocol.columns, protocol.state_fields,
+                        arithmetic=backend_arithmetic(backend.name))
             append_increment(file, simulation.stack.stored(),
                              _row(observer, 0, True, observer.well_index(),
                                   {"yield_element": False, **protocol.initial_row()}))
@@ -174,7 +176,7 @@ def run_simulation(params, output, mesh, backend, *, producer):
         if completed is None:
             _create(output, params, mesh, backend, producer)
         else:
-            rewrite(output, **check_arithmetic(output))
+            rewrite(output, **check_arithmetic(output, backend_arithmetic(backend.name)))
         new, reason = _increments(params, output, backend)
         rewrite(output, completed=True, stop_reason=reason)
         return new

@@ -36,7 +36,7 @@ import dataclasses
 import importlib
 import re
 
-from ..h5io import FileFormatError
+from ..h5io import FileFormatError, attribute
 
 __all__ = ["Format", "FormatError", "register_format", "get_format", "available_formats", "stamp", "check",
            "describe"]
@@ -168,14 +168,13 @@ def check(file, name):
         Naming the file, the format found and the one expected.
     """
     fmt = get_format(name)
-    found = file.attrs.get("format")
-    found = found.decode() if isinstance(found, bytes) else found
+    found = attribute(file, "format", "str", required=False)
     if found is None and "format_version" not in file.attrs and fmt.unstamped == fmt.version:
         return False
     if found is None:
         raise FileFormatError(f"{file.filename}: no 'format' attribute (expected a {name} file, version "
                               f"{fmt.version}; written by an older stickslip? rerun the job that made it)")
-    version = int(file.attrs.get("format_version", -1))
+    version = attribute(file, "format_version", "int", -1, required=False)
     if found != name or version != fmt.version:
         raise FileFormatError(f"{file.filename}: a {found} file version {version}, expected {name} version "
                               f"{fmt.version}")

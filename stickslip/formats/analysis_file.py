@@ -77,7 +77,7 @@ def open_analysis_file(path, fmt):
     file = h5io.open_file(path)
     try:
         check(file, fmt)
-    except h5io.FileFormatError:
-        file.close()
-        raise
+    except BaseException:
+        with file:  # closed; a failure of HDF5 becomes a CorruptFileError naming the file (h5io.open_file)
+            raise
     return file

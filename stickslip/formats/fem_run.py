@@ -18,7 +18,9 @@ equal runs give equal bytes):
     ``protocol`` = "thermal", ``temperature``, ``attempt_rate``, ``drive_rate``, ``hold_times``,
     ``hold_delay``, ``energy_unit``: docs/fem.md, "Finite temperature"); then ``version``
     (package), ``arithmetic`` (what decides the bits of the numbers: a JSON list of segments, each
-    :func:`stickslip.arithmetic.decisive` with the ``from_increment`` it holds from; one segment unless
+    :func:`stickslip.arithmetic.decisive`, for a ``cuda`` run with its GPU, driver, numba-cuda and
+    whether numba's CUDA simulator ran it (:func:`stickslip.fem.backends.gpu_arithmetic`), and the
+    ``from_increment`` it holds from; one segment unless
     a resume was told to continue under another, :func:`check_arithmetic`), ``nstored`` (complete
     increments) and ``completed`` (bool) with ``stop_reason`` ("margin" or "max_increments").
     Format version 2 added ``arithmetic``.
@@ -48,16 +50,18 @@ consumers read them from here and never recompute them.
 import json
 import numbers
 
+import h5py
 import numpy as np
 
 from .. import __version__, formats
 from ..arithmetic import check_resume, decisive
-from ..h5io import FileFormatError, copy_file, open_file, read_array, read_table, write_attrs, write_dataset
+from ..h5io import (FileFormatError, attribute, copy_file, open_file, read_array, read_table, write_attrs,
+                    write_dataset)
 from ..mesh import load_mesh, save_mesh
 from ..output_safety.atomic import atomic_output
 
 __all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
-           "read_increments", "read_run_attrs", "RunFile", "describe", "check_arithmetic"]
+           "read_increments", "read_run_attrs", "stored_increments", "RunFile", "describe", "check_arithmetic"]
 
 #: The format name of these files (:mod:`stickslip.formats`).
 FORMAT = "fem-run"
@@ -104,7 +108,7 @@ def _check_header(header):
         raise ValueError(f"fem-run header: regime must be one of {', '.join(REGIMES)}, got {header['regime']!r}")
 
 
-def create_file(file, header, mesh, linear_response, columns, dtypes=None, state_fields=None):
+def create_file(file, header, mesh, linear_response, columns, dtypes=None, state_fields=None, arithmetic=None):
     """Write the header of a new ``fem-run`` file (no increment yet).
 
     Parameters
@@ -124,6 +128,9 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
     state_fields : Mapping[str, tuple], optional
         Further state stored per increment: name -> ``(shape, dtype)`` of one increment's value
         (datasets ``/state/<name>``; :func:`append_increment` takes their values as a fifth item).
+    arithmetic : Mapping[str, object], optional
+        What decides the bits beside :func:`stickslip.arithmetic.decisive` (a device backend's GPU,
+        :func:`stickslip.fem.backends.backend_arithmetic`), recorded with it in ``arithmetic``.
 
     Raises
     ------
@@ -132,7 +139,7 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
     """
     _check_header(header)
     formats.stamp(file, FORMAT)
-    arithmetic = json.dumps([{"from_increment": 0, **decisive()}], sort_keys=True)
+    arithmetic = json.dumps([{"from_increment": 0, **decisive(), **(arithmetic or {})}], sort_keys=True)
     write_attrs(file, {**header, "version": __version__, "arithmetic": arithmetic, "nstored": 0, "completed": False,
                        "stop_reason": ""})
     save_mesh(mesh, file.create_group("mesh"))
@@ -211,18 +218,21 @@ def rewrite(path, **attrs):
         Root attributes to set in the copy (e.g. ``completed``, ``stop_reason``).
     """
     with open_file(path) as source, atomic_output(path) as tmp:
+        _check(source)
         with open_file(tmp, "w") as target:
-            copy_file(source, target, rows=int(source.attrs["nstored"]))
+            copy_file(source, target, rows=stored_increments(source))
             write_attrs(target, attrs)
 
 
-def check_arithmetic(path):
+def check_arithmetic(path, arithmetic=None):
     """Before a resume: the attributes that record this process's arithmetic, if it is not the stored one.
 
     Parameters
     ----------
     path : str or pathlib.Path
         An incomplete simulation file.
+    arithmetic : Mapping[str, object], optional
+        As :func:`create_file`'s: compared too.
 
     Returns
     -------
@@ -237,17 +247,45 @@ def check_arithmetic(path):
     """
     with open_file(path) as file:
         _check(file)
-        stored, nstored = file.attrs.get("arithmetic", ""), int(file.attrs["nstored"])
-    text = check_resume(path, stored, nstored)
+        stored, nstored = file.attrs.get("arithmetic", ""), stored_increments(file)
+    text = check_resume(path, stored, nstored, extra=arithmetic)
     return {} if text is None else {"arithmetic": text}
 
 
 def _check(file):
-    """Raise unless ``file`` is a ``fem-run`` file of the current version with every :data:`HEADER` field."""
+    """Raise unless ``file`` is a ``fem-run`` file of the current version with every :data:`HEADER` field, each of its
+    kind, and a count of stored increments."""
     formats.check(file, FORMAT)
     missing = [name for name in HEADER if name not in file.attrs]
     if missing:
         raise FileFormatError(f"{file.filename}: fem-run header lacks {', '.join(missing)}")
+    for name, (kind, _) in HEADER.items():
+        value = attribute(file, name, kind)
+        if kind == "json" and not isinstance(value, dict):
+            raise FileFormatError(f"{file.filename}: attribute '{name}' is not a JSON object")
+    regime = attribute(file, "regime", "str")
+    if regime not in REGIMES:
+        raise FileFormatError(f"{file.filename}: attribute 'regime' is {regime!r}, expected one of {', '.join(REGIMES)}")
+    stored_increments(file)
+    attribute(file, "completed", "bool")
+
+
+def stored_increments(file):
+    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``).
+
+    Raises
+    ------
+    FileFormatError
+        If ``nstored`` is not an integer >= 0, or more than the file's rows (``/state/t``).
+    """
+    nstored = attribute(file, "nstored", "int")
+    times = file.get("state/t")
+    if not isinstance(times, h5py.Dataset) or times.ndim != 1:
+        raise FileFormatError(f"{file.filename}: /state/t is not a 1-D dataset (the time of every stored increment)")
+    if not 0 <= nstored <= times.shape[0]:
+        raise FileFormatError(f"{file.filename}: attribute 'nstored' is {nstored}, expected 0 ... the "
+                              f"{times.shape[0]} rows of /state/t")
+    return nstored
 
 
 def read_params(file):
@@ -270,7 +308,7 @@ def read_params(file):
         If the file is not a ``fem-run`` file of the current version.
     """
     _check(file)
-    return json.loads(file.attrs["params"])
+    return attribute(file, "params", "json")
 
 
 class RunFile:
@@ -299,7 +337,7 @@ class RunFile:
         self.file = file
         self.params = read_params(file)
         self.mesh = load_mesh(file["mesh"])
-        self.nstored = int(file.attrs["nstored"])
+        self.nstored = stored_increments(file)
 
     def state(self, increment):
         """(u, target, lever_target, t) of a stored increment; a file with further state adds a mapping of it."""
@@ -353,7 +391,7 @@ def read_increments(path):
     """
     with open_file(path) as file:
         _check(file)
-        return read_table(file, "increments", rows=int(file.attrs["nstored"]))
+        return read_table(file, "increments", rows=stored_increments(file))
 
 
 def read_run_attrs(path):
@@ -380,8 +418,8 @@ def read_run_attrs(path):
         out = {}
         for key, value in file.attrs.items():
             out[key] = value.item() if isinstance(value, np.generic) else value
-        out["params"] = json.loads(out["params"])
-        out["completed"] = bool(out["completed"])
+        out.update({name: attribute(file, name, kind) for name, (kind, _) in HEADER.items()})
+        out["nstored"], out["completed"] = stored_increments(file), attribute(file, "completed", "bool")
         return out
 
 
@@ -398,13 +436,17 @@ def describe(path):
         and ``junction_attempt_rate`` (None otherwise).
     """
     attrs = read_run_attrs(path)
-    thermal = attrs.get("protocol") == "thermal"
-    aging = "junction_strengthening" in attrs
-    return {"n": int(attrs["n_interfaces"]), "plates": int(attrs["plates"]), "blocks": int(attrs["N"]),
-            "k_drive": float(attrs["k_drive"]), "phi": float(attrs["phi"]), "regime": str(attrs["regime"]),
-            "seed": int(attrs["seed"]), "temperature": float(attrs["temperature"]) if thermal else 0.0,
-            "attempt_rate": float(attrs["attempt_rate"]) if thermal else None,
-            "drive_rate": float(attrs["drive_rate"]) if thermal else None,
-            "junction_strengthening": float(attrs["junction_strengthening"]) if aging else 0.0 if thermal else None,
-            **{name: float(attrs[name]) if aging else None
-               for name in ("junction_glass_temperature", "junction_attempt_rate")}}
+    with open_file(path) as file:
+        thermal = attribute(file, "protocol", "str", "", required=False) == "thermal"
+        aging = "junction_strengthening" in attrs
+
+        def number(name, used):
+            return attribute(file, name, "float") if used else None
+
+        return {"n": attrs["n_interfaces"], "plates": attrs["plates"], "blocks": attrs["N"],
+                "k_drive": attrs["k_drive"], "phi": attrs["phi"], "regime": attrs["regime"], "seed": attrs["seed"],
+                "temperature": number("temperature", thermal) or 0.0,
+                "attempt_rate": number("attempt_rate", thermal), "drive_rate": number("drive_rate", thermal),
+                "junction_strengthening": number("junction_strengthening", aging) if aging else 0.0 if thermal
+                else None,
+                **{name: number(name, aging) for name in ("junction_glass_temperature", "junction_attempt_rate")}}

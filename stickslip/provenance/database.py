@@ -21,7 +21,11 @@ Views ``slip_events_full`` and ``periodicity_full``: slip_events and run_periodi
 the parameters of their simulation.
 """
 
-from sqlalchemy import Boolean, Float, ForeignKey, Index, Integer, String, Text, create_engine, event, text
+import sqlite3
+import urllib.parse
+from pathlib import Path
+
+from sqlalchemy import URL, Boolean, Float, ForeignKey, Index, Integer, String, Text, create_engine, event, text
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
 
 from ..h5io import FileFormatError
@@ -226,10 +230,11 @@ def engine_for(path, *, readonly=False):
     -------
     sqlalchemy.engine.Engine
     """
-    if readonly:
-        engine = create_engine(f"sqlite+pysqlite:///file:{path}?mode=ro&uri=true")
+    if readonly:  # a URI, its path escaped: '?', '#' and '%' are a file name's characters, not the URI's
+        uri = f"file:{urllib.parse.quote(str(Path(path).absolute()))}?mode=ro"
+        engine = create_engine("sqlite+pysqlite://", creator=lambda: sqlite3.connect(uri, uri=True))
     else:
-        engine = create_engine(f"sqlite+pysqlite:///{path}")
+        engine = create_engine(URL.create("sqlite+pysqlite", database=str(path)))
 
     @event.listens_for(engine, "connect")
     def _foreign_keys(connection, _record):

@@ -7,13 +7,24 @@ never change it, and returns a :class:`pandas.DataFrame`. Filters left at
 Every query stops on Ctrl-C (SIGINT) within a fraction of a second, also in the middle of
 SQLite's work (a progress handler checks every :data:`CHECK_EVERY` virtual-machine
 instructions), and :func:`sql` (``stickslip db sql``) is bounded by default: its time
-(:data:`TIME_LIMIT_S`), the rows it returns (:data:`MAX_ROWS`) and SQLite's memory
-(:data:`MEMORY_LIMIT_MIB`, temporary tables and sorts included, which are kept in memory); a
-query past a bound stops with a :class:`QueryError` naming the bound and how to raise it.
+(:data:`TIME_LIMIT_S`: SQLite's work and the fetching of the rows), the rows it returns
+(:data:`MAX_ROWS`) and its memory (:data:`MEMORY_LIMIT_MIB`): SQLite's heap, temporary tables and
+sorts included (which are kept in memory), and the rows fetched, counted in bytes as they stream;
+a query past a bound stops with a :class:`QueryError` naming the bound and how to raise it.
+
+The bounds belong to one query: SQLite's heap limit is process-wide in SQLite, so it is set for
+the query (other SQLite connections of the process share it meanwhile) and the limit set before
+is restored after it (:class:`_Heap`).
 """
 
+import _sqlite3
+import ctypes
+import itertools
+import math
+import numbers
 import signal
 import sqlite3
+import sys
 import threading
 import time
 from contextlib import contextmanager
@@ -28,8 +39,8 @@ from ..vocabulary import dtype_matches, expand_json, quantity, typed
 from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
 
-__all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "TIME_LIMIT_S", "MAX_ROWS", "MEMORY_LIMIT_MIB",
-           "CHECK_EVERY", "runs", "events", "figures", "sql"]
+__all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S", "MAX_ROWS",
+           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "check_bounds"]
 
 #: Where the workflow writes the database of the default study (relative to the workflow directory);
 #: a study named S has ``results/S/stickslip.sqlite``.
@@ -42,8 +53,10 @@ MAX_ROWS = 1_000_000
 MEMORY_LIMIT_MIB = 1024
 #: SQLite virtual-machine instructions between two checks for Ctrl-C and the time limit (~1 ms).
 CHECK_EVERY = 10_000
-#: Rows fetched at a time (the row bound is checked between fetches).
+#: Rows fetched at a time at most (the bounds are checked between fetches) ...
 _FETCH = 10_000
+#: ... and about as many bytes at most (rows of large values are fetched a few at a time).
+_PIECE_BYTES = 8 * 2**20
 
 
 class QueryError(ValueError):
@@ -65,8 +78,15 @@ READ_ONLY_PRAGMAS = ("table_info", "table_xinfo", "table_list", "index_list", "i
 _READING = (sqlite3.SQLITE_SELECT, sqlite3.SQLITE_READ, sqlite3.SQLITE_FUNCTION, sqlite3.SQLITE_RECURSIVE)
 
 
+#: SQL functions that ``db sql`` refuses: they hand out or take pointers (``fts3_tokenizer``, ``fts5``) or load code.
+DENIED_FUNCTIONS = ("fts3_tokenizer", "fts5", "load_extension")
+
+
 def _only_reading(action, name, argument, _database, _trigger):
-    """SQLite authorizer: allow reading, deny everything else (ATTACH, VACUUM INTO, temporary tables, PRAGMA writes)."""
+    """SQLite authorizer: allow reading, deny everything else (ATTACH, VACUUM INTO, temporary tables, PRAGMA writes,
+    the functions of :data:`DENIED_FUNCTIONS`)."""
+    if action == sqlite3.SQLITE_FUNCTION and str(argument).lower() in DENIED_FUNCTIONS:
+        return sqlite3.SQLITE_DENY
     if action in _READING or (action == sqlite3.SQLITE_PRAGMA and name in READ_ONLY_PRAGMAS):
         return sqlite3.SQLITE_OK
     return sqlite3.SQLITE_DENY
@@ -79,91 +99,211 @@ def _check_schema(database, connection):
         raise QueryError(f"database schema version {found}, expected {SCHEMA_VERSION}: {SCHEMA_HINT}")
 
 
-@contextmanager
-def _stoppable(driver, time_limit, memory_limit_mib):
-    """Let a query on the sqlite3 connection ``driver`` stop on Ctrl-C, at ``time_limit`` [s] and past
-    ``memory_limit_mib`` of SQLite's heap; yields a dict whose ``"stop"`` says why it stopped ("" if not)."""
-    state = {"stop": ""}
-    deadline = None if time_limit is None else time.monotonic() + time_limit
+class _Heap:
+    """SQLite's process-wide heap limit (``sqlite3_hard_heap_limit64``), set for one query and restored after.
 
-    def check():
-        if not state["stop"] and deadline is not None and time.monotonic() > deadline:
-            state["stop"] = "time"
-        return 1 if state["stop"] else 0
+    The ``hard_heap_limit`` PRAGMA can only lower the limit, never lift it, so a query that set it would cap
+    every later SQLite connection of the process; the C functions, reached through the library Python's
+    ``sqlite3`` module uses, set and restore it. Where they cannot be reached (an SQLite built without them),
+    ``available`` is False and no heap limit is set (the rows are still bounded, :class:`_Bounds`).
+    """
 
-    def interrupted(_signum, _frame):
-        state["stop"] = "interrupt"  # seen by check() at SQLite's next CHECK_EVERY instructions
+    lock = threading.Lock()  # bounded queries in threads take turns with the process-wide limit
 
-    main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, interrupted) if main else None
-    driver.set_progress_handler(check, CHECK_EVERY)
-    if memory_limit_mib is not None:
-        driver.execute("PRAGMA temp_store = MEMORY")  # temporary tables and sorts count against the limit
-        driver.execute(f"PRAGMA hard_heap_limit = {int(memory_limit_mib * 2**20)}")
-    try:
-        yield state
-    finally:
-        if memory_limit_mib is not None:
-            driver.execute("PRAGMA hard_heap_limit = 0")  # process-wide in SQLite: lift it again
-        driver.set_progress_handler(None, 0)
-        if main:
-            signal.signal(signal.SIGINT, previous)
-        if state["stop"] == "interrupt":
-            raise KeyboardInterrupt
+    def __init__(self):
+        try:
+            library = ctypes.CDLL(_sqlite3.__file__)
+            self.hard, self.soft = library.sqlite3_hard_heap_limit64, library.sqlite3_soft_heap_limit64
+            self.highwater = library.sqlite3_memory_highwater
+        except (OSError, AttributeError):
+            self.hard = self.soft = self.highwater = None
+        for function in (self.hard, self.soft):
+            if function is not None:
+                function.restype, function.argtypes = ctypes.c_int64, [ctypes.c_int64]
+        if self.highwater is not None:
+            self.highwater.restype, self.highwater.argtypes = ctypes.c_int64, [ctypes.c_int]
+
+    @property
+    def available(self):
+        """Whether the limit can be set and restored."""
+        return None not in (self.hard, self.soft, self.highwater)
+
+    @contextmanager
+    def limited(self, nbytes):
+        """Within the block SQLite's heap is limited to ``nbytes`` (or the limit set before, if lower)."""
+        if nbytes is None or not self.available:
+            yield
+            return
+        with self.lock:
+            hard, soft = self.hard(-1), self.soft(-1)  # -1: ask, change nothing
+            self.hard(min(nbytes, hard) if hard > 0 else nbytes)
+            self.highwater(1)  # from here: the most SQLite held during the query
+            try:
+                yield
+            finally:
+                self.hard(hard)
+                self.soft(soft)  # lowering the hard limit lowered the soft one too
+
+    def exhausted(self, nbytes):
+        """Whether SQLite's heap came near ``nbytes`` during the query (a MemoryError was its limit, not the machine's)."""
+        return self.available and nbytes is not None and self.highwater(0) > 0.5 * nbytes
 
 
-def _rows(connection, statement, max_rows):
-    """The rows of ``statement`` as a DataFrame, fetched in pieces; raises QueryError past ``max_rows``."""
+_HEAP = _Heap()
+
+
+class _Bounds:
+    """The bounds of one query: Ctrl-C, time (SQLite's work and the fetching), rows, and memory.
+
+    Memory: SQLite's heap (:class:`_Heap`, temporary tables and sorts kept in memory) and the rows fetched,
+    counted in bytes as they stream (the Python objects of every value and row, :func:`_row_bytes`); each
+    bounded by ``memory_limit_mib``.
+    """
+
+    def __init__(self, time_limit=None, max_rows=None, memory_limit_mib=None):
+        self.time_limit, self.max_rows, self.memory_limit_mib = time_limit, max_rows, memory_limit_mib
+        self.memory = None if memory_limit_mib is None else int(memory_limit_mib * 2**20)
+        self.deadline = None if time_limit is None else time.monotonic() + time_limit
+        self.stop, self.rows, self.bytes = "", 0, 0
+
+    def check(self):
+        """SQLite's progress handler, and between fetches: 1 (stop) past the deadline or after Ctrl-C."""
+        if not self.stop and self.deadline is not None and time.monotonic() > self.deadline:
+            self.stop = "time"
+        return 1 if self.stop else 0
+
+    @contextmanager
+    def applied(self, driver):
+        """Within the block a query on the sqlite3 connection ``driver`` stops at the bounds (Ctrl-C: raised)."""
+        def interrupted(_signum, _frame):
+            self.stop = "interrupt"  # seen by check() at SQLite's next CHECK_EVERY instructions
+
+        main = threading.current_thread() is threading.main_thread()
+        previous = signal.signal(signal.SIGINT, interrupted) if main else None
+        driver.set_progress_handler(self.check, CHECK_EVERY)
+        if self.memory is not None:
+            driver.execute("PRAGMA temp_store = MEMORY")  # temporary tables and sorts count against the limit
+        try:
+            with _HEAP.limited(self.memory):
+                yield self
+        finally:
+            driver.set_progress_handler(None, 0)
+            if main:
+                signal.signal(signal.SIGINT, previous)
+            if self.stop == "interrupt":
+                raise KeyboardInterrupt
+
+    def take(self, piece):
+        """Count a piece of fetched rows; raise QueryError past a bound (rows, bytes, time)."""
+        self.rows += len(piece)
+        self.bytes += _row_bytes(piece)
+        if self.max_rows is not None and self.rows > self.max_rows:
+            raise QueryError(f"the query returns more than {self.max_rows} rows (the bound on rows: add LIMIT, or "
+                             f"raise it with `db sql --max-rows N`, max_rows= in Python)")
+        if self.memory is not None and self.bytes > self.memory:
+            raise QueryError(f"the query's rows reached the memory limit of {self.memory_limit_mib:g} MiB after "
+                             f"{self.rows} rows (raise it with `db sql --memory-limit MIB`, memory_limit_mib= in "
+                             f"Python; 0: no limit)")
+        if self.check():
+            raise _Stopped
+
+    def error(self, database, cause):
+        """The QueryError of a query that a bound stopped (``cause``: SQLite's error, or None), or None."""
+        if self.stop == "time":
+            return QueryError(f"{database}: the query ran into the time limit of {self.time_limit:g} s (raise it "
+                              f"with `db sql --time-limit SECONDS`, time_limit= in Python; 0: no limit)")
+        if "out of memory" in str(cause) and self.memory is not None:
+            return QueryError(f"{database}: the query reached SQLite's memory limit of {self.memory_limit_mib:g} MiB "
+                              f"(raise it with `db sql --memory-limit MIB`, memory_limit_mib= in Python; 0: no limit)")
+        return None
+
+
+class _Stopped(Exception):
+    """A bound (time, Ctrl-C) seen between two fetches."""
+
+
+def _row_bytes(rows):
+    """Bytes that fetched rows hold in Python: every value's object and every row's tuple."""
+    values = itertools.chain.from_iterable(rows)
+    return sum(map(sys.getsizeof, values)) + sum(map(sys.getsizeof, rows))
+
+
+def _rows(connection, statement, bounds):
+    """The rows of ``statement`` as a DataFrame, fetched in pieces that the bounds count (:meth:`_Bounds.take`).
+
+    A piece holds up to :data:`_FETCH` rows and about :data:`_PIECE_BYTES`: rows of large values (blobs) are
+    fetched a few at a time, so that no piece passes the memory bound by much.
+    """
     result = connection.execute(statement)
     columns = list(result.keys())
-    rows = []
+    rows, size = [], 16
     while True:
-        piece = result.fetchmany(_FETCH)
-        rows += piece
-        if max_rows is not None and len(rows) > max_rows:
+        piece = result.fetchmany(size)
+        try:
+            bounds.take(piece)
+        except BaseException:
             result.close()
-            raise QueryError(f"the query returns more than {max_rows} rows (the bound on rows: add LIMIT, or raise "
-                             f"it with `db sql --max-rows N`, max_rows= in Python)")
-        if len(piece) < _FETCH:
+            raise
+        rows += piece
+        if len(piece) < size:
             return pd.DataFrame.from_records(rows, columns=columns, coerce_float=True)
+        row_bytes = max(1, _row_bytes(piece) // len(piece))
+        size = int(min(_FETCH, max(1, _PIECE_BYTES // row_bytes)))
 
 
-def _bound_error(database, stop, cause, time_limit, memory_limit_mib):
-    """The QueryError of a query that a bound stopped, or None."""
-    if stop == "time":
-        return QueryError(f"{database}: the query ran into the time limit of {time_limit:g} s (raise it with "
-                          f"`db sql --time-limit SECONDS`, time_limit= in Python; 0: no limit)")
-    if "out of memory" in str(cause) and memory_limit_mib is not None:
-        return QueryError(f"{database}: the query reached SQLite's memory limit of {memory_limit_mib:g} MiB (raise it "
-                          f"with `db sql --memory-limit MIB`, memory_limit_mib= in Python; 0: no limit)")
-    return None
+def check_bounds(time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS, memory_limit_mib=MEMORY_LIMIT_MIB):
+    """The bounds of :func:`sql` checked, each None where there is none (None or 0).
+
+    Raises
+    ------
+    QueryError
+        If a bound is not a number >= 0 (``max_rows`` an integer), naming it.
+    """
+    def number(name, option, value, integer=False):
+        kinds = (numbers.Integral,) if integer else (numbers.Real,)
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, kinds) or not math.isfinite(value) or value < 0:
+            what = "an integer" if integer else "a number"
+            raise QueryError(f"{name} ({option}): expected {what} >= 0 (0: no limit), got {value!r}")
+        return value or None
+
+    return (number("time_limit", "--time-limit SECONDS", time_limit),
+            number("max_rows", "--max-rows N", max_rows, integer=True),
+            number("memory_limit_mib", "--memory-limit MIB", memory_limit_mib))
 
 
 def _frame(database, statement, only_reading=False, time_limit=None, max_rows=None, memory_limit_mib=None):
     engine = _engine(database)
-    state = {"stop": ""}
+    bounds = _Bounds(time_limit, max_rows, memory_limit_mib)
     try:
         with engine.connect() as connection:
             _check_schema(database, connection)
             driver = connection.connection.driver_connection
-            with _stoppable(driver, time_limit, memory_limit_mib) as state:
+            with bounds.applied(driver):
                 if only_reading:
                     driver.set_authorizer(_only_reading)
                 try:
-                    frame = _rows(connection, statement, max_rows)
+                    frame = _rows(connection, statement, bounds)
                 finally:
                     driver.set_authorizer(None)
+    except _Stopped:
+        if bounds.stop == "interrupt":
+            raise KeyboardInterrupt from None
+        raise bounds.error(database, None) from None
     except sqlalchemy.exc.ResourceClosedError:
         raise QueryError(f"{database}: the statement returns no rows; `db sql` runs queries (SELECT)") from None
     except QueryError as error:
         raise QueryError(f"{database}: {error}") from None
-    except MemoryError:  # SQLITE_NOMEM: the heap limit (Python's own rows are bounded by max_rows)
-        if memory_limit_mib is None:
-            raise
-        raise _bound_error(database, "", "out of memory", time_limit, memory_limit_mib) from None
+    except MemoryError:  # SQLITE_NOMEM at the heap limit, or the machine's memory
+        if not _HEAP.exhausted(bounds.memory):
+            raise QueryError(f"{database}: the machine ran out of memory during the query, after {bounds.rows} rows "
+                             f"({bounds.bytes / 2**20:.0f} MiB); add LIMIT or lower `db sql --memory-limit MIB`, "
+                             "memory_limit_mib= in Python") from None
+        raise bounds.error(database, "out of memory") from None
     except (pd.errors.DatabaseError, sqlalchemy.exc.DBAPIError) as error:
         cause = getattr(error.__cause__, "orig", None) or getattr(error, "orig", None) or error.__cause__ or error
-        bound = _bound_error(database, state["stop"], cause, time_limit, memory_limit_mib)
+        bound = bounds.error(database, cause)
         if bound is not None:
             raise bound from None
         if "authoriz" in str(cause):  # "not authorized", "authorization denied"
@@ -344,7 +484,8 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     max_rows : int or None
         Refuse a result of more rows; None or 0: no limit.
     memory_limit_mib : float or None
-        SQLite's memory (heap, temporary tables and sorts included) [MiB]; None or 0: no limit.
+        Memory [MiB] of SQLite (heap, temporary tables and sorts included), and of the rows fetched
+        (the table built from them takes up to as much again); None or 0: no limit.
 
     Returns
     -------
@@ -355,7 +496,8 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     Raises
     ------
     QueryError
-        If the SQL is empty or wrong, returns no rows, does anything but read, or runs into a bound.
+        If the SQL is empty or wrong, returns no rows, does anything but read, or runs into a bound; or a
+        bound is not a number >= 0.
     KeyboardInterrupt
         On Ctrl-C (SIGINT), within a fraction of a second.
 
@@ -363,7 +505,8 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     -----
     Cost: whatever the query costs, within the bounds; the indexes are listed in docs/database.md.
     """
-    if not query.strip():
+    time_limit, max_rows, memory_limit_mib = check_bounds(time_limit, max_rows, memory_limit_mib)
+    if not isinstance(query, str) or not query.strip():
         raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
-    return _units(_frame(database, text(query), only_reading=True, time_limit=time_limit or None,
-                         max_rows=max_rows or None, memory_limit_mib=memory_limit_mib or None))
+    return _units(_frame(database, text(query), only_reading=True, time_limit=time_limit, max_rows=max_rows,
+                         memory_limit_mib=memory_limit_mib))

@@ -89,6 +89,17 @@ def with_gpu_rule_resources(name):
 
 
 onstart:
+    # A local run with jobs on a GPU (fem, backend cuda) checks, before any job, that this machine can run them.
+    if workflow.executor_plugin is not None and workflow.executor_plugin.name == "local":
+        gpu_jobs = [job for job in workflow.dag.needrun_jobs() if job.resources.get("gpu")]
+        if gpu_jobs:
+            from stickslip.fem.backends import make_backend
+
+            try:
+                make_backend("cuda")
+            except ParameterError as error:
+                raise WorkflowError(f"{len(gpu_jobs)} job(s) run on a GPU ({gpu_jobs[0].rule.name}, ...): "
+                                    f"{error}") from None
     # A SLURM run checks, before submitting anything, that it would not hang (stickslip.cluster).
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
         from snakemake_executor_plugin_slurm.partitions import parse_gpu_requirements

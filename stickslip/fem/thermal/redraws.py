@@ -18,6 +18,14 @@ The athermal threshold is the drive offset at which the first Gauss point reache
 strain along the linear response (``eps + ds deps``, a quadratic per Gauss point), kept per block and
 recomputed for a block whose junction is redrawn (a narrower well comes sooner); the load step of
 the protocol then goes to the brink exactly (:meth:`..loading.Loading.step`).
+
+Bounded, and stoppable: the compiled loop (:func:`redraw_loop`) applies at most :data:`REDRAWS_PER_CALL`
+redraws per call and returns to Python (:data:`PAUSED`), where Ctrl-C and SIGTERM are handled, then
+:func:`sample_with_redraws` calls it again from where it paused: the same draws, bit for bit, as one
+call. The redraws before one event are bounded by :func:`redraw_bound` (:data:`REDRAW_MARGIN` times what
+the trap model expects, :func:`.junctions.expected_redraws`): beyond it the sampling stops with an error
+naming the parameters instead of running for ever (parameters that would need that many are refused
+before the run, :mod:`..parameters`).
 """
 
 import math
@@ -25,14 +33,28 @@ import math
 import numpy as np
 
 from ...numba_options import njit
-from .junctions import widening
-from .sampler import HOP, NONE, THRESHOLD, exponential, sample_event, uniform
+from ..errors import SolverError
+from .junctions import expected_redraws, widening
+from .sampler import HOP, NONE, STALLED, THRESHOLD, draw_event, exponential, stalled_error, uniform
 
-__all__ = ["REDRAW", "block_threshold", "sample_with_redraws"]
+__all__ = ["REDRAW", "PAUSED", "REDRAWS_PER_CALL", "REDRAW_MARGIN", "REDRAW_FLOOR", "block_threshold",
+           "sample_with_redraws", "redraw_loop", "redraw_bound"]
 
 #: Kind of event returned by :func:`sample_with_redraws` (beside :data:`.sampler.NONE`, ``HOP``,
 #: ``THRESHOLD``): a junction redrawn so shallow that a Gauss point of its block leaves its well.
 REDRAW = 3
+
+#: Kind returned by :func:`redraw_loop` after :data:`REDRAWS_PER_CALL` redraws (not an event: call it again).
+PAUSED = 4
+
+#: Redraws one call of :func:`redraw_loop` applies at most (~10 ms at N = 9, ~0.3 s at N = 162 with 2 interfaces).
+REDRAWS_PER_CALL = 10_000
+
+#: The bound on the redraws before one event: this many times the trap model's expectation for every block
+#: over the time to the athermal threshold or the end of the stretch (:func:`redraw_bound`) ...
+REDRAW_MARGIN = 100.0
+#: ... and at least this many.
+REDRAW_FLOOR = 100_000
 
 
 @njit
@@ -92,10 +114,11 @@ def _redraw_rates(well, depth, inv_temperature, nu_j, out):
     return total
 
 
-@njit
 def sample_with_redraws(law, epsy, base, offset, well, depth, scale, glass_temperature, nu_j, inv_temperature,
                         idx, eps, deps, dV, allowed, beta, nu, speed, duration, state, inc):
     """The next event after now (drive offset 0), with the junction redraws before it applied (module docstring).
+
+    Calls :func:`redraw_loop` until it returns an event; between calls Python handles signals.
 
     Parameters
     ----------
@@ -135,22 +158,104 @@ def sample_with_redraws(law, epsy, base, offset, well, depth, scale, glass_tempe
         Redraws applied before the event.
     new_depth : float
         A :data:`REDRAW`'s new depth (not applied), else NaN.
+
+    Raises
+    ------
+    stickslip.fem.errors.SolverError
+        If the redraws before the event exceed :func:`redraw_bound`, or a draw of the hops gave up
+        (:func:`.sampler.stalled_error`); the message names the parameters.
+    """
+    thresholds = np.empty(idx.shape[0])
+    block_thresholds(epsy, idx, eps, deps, thresholds)
+    horizon = min(duration, thresholds.min() / speed) if speed > 0.0 else duration
+    bound = redraw_bound(idx.shape[0], nu_j, 1.0 / inv_temperature, glass_temperature, horizon)
+    t, ds, redraws = 0.0, 0.0, 0
+    while True:
+        kind, block, direction, t, ds, redraws, new_depth = redraw_loop(
+            law, epsy, base, offset, well, depth, scale, glass_temperature, nu_j, inv_temperature, idx, eps, deps, dV,
+            allowed, beta, nu, speed, duration, state, inc, t, ds, redraws, REDRAWS_PER_CALL)
+        if kind == STALLED:
+            raise stalled_error(beta, nu, speed)
+        if kind != PAUSED:
+            return kind, block, direction, t, ds, redraws, new_depth
+        if redraws > bound:
+            T = 1.0 / inv_temperature
+            expected = expected_redraws(nu_j, T, glass_temperature, horizon)
+            raise SolverError(f"junction aging: {redraws} junction redraws before the next event, more than "
+                              f"{REDRAW_MARGIN:g} times the trap model's {expected:.3g} per block "
+                              f"({idx.shape[0]} blocks) over the {horizon:.3g} time to the athermal threshold "
+                              f"or the end of the stretch (temperature = {T:g}, junction_glass_temperature = "
+                              f"{glass_temperature:g}, junction_attempt_rate = {nu_j:g}); expected a glass temperature "
+                              "well above the temperature or a lower junction_attempt_rate (docs/fem.md, "
+                              "'Junction aging')")
+
+
+def redraw_bound(blocks, attempt_rate, temperature, glass_temperature, duration):
+    """The most redraws :func:`sample_with_redraws` applies before one event (``REDRAW_MARGIN blocks n``, at least
+    :data:`REDRAW_FLOOR`).
+
+    Parameters
+    ----------
+    blocks : int
+        Interface blocks.
+    attempt_rate, temperature, glass_temperature, duration
+        As :func:`.junctions.expected_redraws` (``n``); ``duration`` the time to the athermal threshold or
+        the end of the stretch [time].
+
+    Returns
+    -------
+    float
+        ``inf`` for an infinite duration (a hold without end: tests only).
+    """
+    return max(REDRAW_FLOOR, REDRAW_MARGIN * blocks * expected_redraws(attempt_rate, temperature, glass_temperature,
+                                                                        duration))
+
+
+@njit
+def block_thresholds(epsy, idx, eps, deps, out):
+    """``out[e]`` = :func:`block_threshold` of every block ``e``."""
+    for e in range(idx.shape[0]):
+        out[e] = block_threshold(epsy, idx, eps, deps, e)
+
+
+@njit
+def redraw_loop(law, epsy, base, offset, well, depth, scale, glass_temperature, nu_j, inv_temperature, idx, eps, deps,
+                dV, allowed, beta, nu, speed, duration, state, inc, t, ds, redraws, chunk):
+    """The compiled loop of :func:`sample_with_redraws`, from time ``t`` and offset ``ds`` after ``redraws`` redraws.
+
+    Parameters
+    ----------
+    law, epsy, ..., inc
+        As :func:`sample_with_redraws`.
+    t, ds : float
+        Time [time] and drive offset [response units] reached (0 at the first call).
+    redraws : int
+        Redraws applied so far.
+    chunk : int
+        Return :data:`PAUSED` after this many more redraws.
+
+    Returns
+    -------
+    tuple
+        As :func:`sample_with_redraws`; kind :data:`PAUSED` with the time and offset reached (call again from
+        there) or :data:`.sampler.STALLED`.
     """
     ni = idx.shape[0]
     thresholds = np.empty(ni)
-    for e in range(ni):
-        thresholds[e] = block_threshold(epsy, idx, eps, deps, e)
+    block_thresholds(epsy, idx, eps, deps, thresholds)
     rates = np.empty(ni)
     total = _redraw_rates(well, depth, inv_temperature, nu_j, rates)
-    t, ds, redraws = 0.0, 0.0, 0
+    stop = redraws + chunk
     while True:
         ds_c = thresholds.min()
         if speed > 0.0 and ds_c <= ds:
             return THRESHOLD, -1, -1, t, ds, redraws, math.nan
         tau = exponential(state, inc) / total if total > 0.0 else math.inf
         stretch = min(duration - t, tau)
-        kind, e, d, dt = sample_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds, speed, stretch, ds_c,
-                                      state, inc)
+        kind, e, d, dt = draw_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds, speed, stretch, ds_c,
+                                    state, inc)
+        if kind == STALLED:
+            return STALLED, -1, -1, t + dt, ds, redraws, math.nan
         if kind == HOP:
             return HOP, e, d, t + dt, ds + speed * dt, redraws, math.nan
         if kind == THRESHOLD:
@@ -179,3 +284,5 @@ def sample_with_redraws(law, epsy, base, offset, well, depth, scale, glass_tempe
         redraws += 1
         total = _redraw_rates(well, depth, inv_temperature, nu_j, rates)
         thresholds[b] = block_threshold(epsy, idx, eps, deps, b)
+        if redraws >= stop:
+            return PAUSED, -1, -1, t, ds, redraws, math.nan

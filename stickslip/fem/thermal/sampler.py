@@ -19,6 +19,12 @@ window's start or expects at most one candidate, and doubled after each window. 
 
 Random numbers: pcg32 (:mod:`..random`), 53-bit uniforms from two draws; the caller seeds one
 stream per increment, so that a run resumed from any stored increment draws the same numbers.
+
+Bounded: one draw (:func:`draw_event`, the compiled kernel) makes at most :data:`MAX_DRAWS` windows and
+candidates (a few to a few hundred in the regimes the studies run), then gives up (:data:`STALLED`);
+:func:`sample_event` turns that into a :class:`..errors.SolverError` naming the parameters, so that no
+rates, however extreme, make a run loop for ever (and one call returns to Python within a second or so,
+where Ctrl-C and SIGTERM are handled).
 """
 
 import math
@@ -26,16 +32,24 @@ import math
 import numpy as np
 
 from ...numba_options import njit
+from ..errors import SolverError
 from ..random import pcg32_next
 from .barriers import barrier_bounds, block_barrier, block_barriers
 
-__all__ = ["NONE", "HOP", "THRESHOLD", "TIGHT", "sample_event", "uniform", "exponential"]
+__all__ = ["NONE", "HOP", "THRESHOLD", "STALLED", "TIGHT", "MAX_DRAWS", "sample_event", "draw_event", "uniform",
+           "exponential", "stalled_error"]
 
 #: Kinds of event returned by :func:`sample_event`: nothing before the end of the stretch,
 #: a thermally activated hop, the athermal threshold.
 NONE = 0
 HOP = 1
 THRESHOLD = 2
+#: Kind returned by :func:`draw_event` when it gave up after :data:`MAX_DRAWS` windows and candidates.
+STALLED = -1
+
+#: Windows and candidate hops one draw makes at most: far beyond any draw of the studies' regimes (tens),
+#: reached only when the rates are beyond what the method resolves (then an error, never an endless loop).
+MAX_DRAWS = 1_000_000
 
 #: A window is accepted when its bound exceeds the rate at its start by at most this factor (or
 #: expects at most one candidate).
@@ -85,9 +99,43 @@ def _pick(weights, total, u):
     return last_e, last_d
 
 
-@njit
 def sample_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds0, speed, duration, ds_c, state, inc):
-    """The next event after now, drawn exactly.
+    """The next event after now, drawn exactly (:func:`draw_event`; its bound raised as an error).
+
+    Parameters and returns as :func:`draw_event`, which never returns :data:`STALLED` here.
+
+    Raises
+    ------
+    stickslip.fem.errors.SolverError
+        If the draw gave up after :data:`MAX_DRAWS` windows and candidates (:func:`stalled_error`).
+    """
+    drawn = draw_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds0, speed, duration, ds_c, state, inc)
+    if drawn[0] == STALLED:
+        raise stalled_error(beta, nu, speed)
+    return drawn
+
+
+def stalled_error(beta, nu, speed):
+    """The :class:`..errors.SolverError` of a draw that reached :data:`MAX_DRAWS`, naming the parameters.
+
+    Parameters
+    ----------
+    beta : float
+        ``1 / T`` [1/energy].
+    nu : float
+        Attempt rate [1/time].
+    speed : float
+        Drive offset per unit time.
+    """
+    return SolverError(f"the thermal sampling made {MAX_DRAWS} windows and candidate hops without finding the next "
+                       f"event (attempt_rate = {nu:g}/time, 1/T = {beta:.6g} per energy unit, drive offset speed "
+                       f"{speed:.6g}/time): the hop rates change faster than the kinetic Monte Carlo resolves; "
+                       "expected a lower attempt_rate, temperature or drive_rate (docs/fem.md, 'Limits of the regime')")
+
+
+@njit
+def draw_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds0, speed, duration, ds_c, state, inc):
+    """The next event after now, drawn exactly (the compiled kernel of :func:`sample_event`).
 
     Parameters
     ----------
@@ -114,11 +162,12 @@ def sample_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds0, speed, d
     Returns
     -------
     kind : int
-        :data:`NONE` (the stretch ended first), :data:`HOP` or :data:`THRESHOLD`.
+        :data:`NONE` (the stretch ended first), :data:`HOP` or :data:`THRESHOLD`; :data:`STALLED` after
+        :data:`MAX_DRAWS` windows and candidates without an event.
     block, direction : int
         The hop (-1 otherwise).
     dt : float
-        Time from now to the event (or to the end of the stretch).
+        Time from now to the event (or to the end of the stretch; for :data:`STALLED` to where it gave up).
     """
     ni = idx.shape[0]
     energies = np.empty((ni, 2))
@@ -136,7 +185,11 @@ def sample_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds0, speed, d
     t = 0.0
     width = t_end
     bounds = np.empty((ni, 2))
+    draws = 0
     while t < t_end:
+        draws += 1
+        if draws > MAX_DRAWS:
+            return STALLED, -1, -1, t
         ta = t
         tb = min(t + width, t_end)
         barrier_bounds(law, epsy, idx, eps, deps, dV, ds0 + speed * t, ds0 + speed * tb, energies)
@@ -147,6 +200,9 @@ def sample_event(law, epsy, idx, eps, deps, dV, allowed, beta, nu, ds0, speed, d
                 width = 0.5 * (tb - ta)
                 continue
         while True:
+            draws += 1
+            if draws > MAX_DRAWS:
+                return STALLED, -1, -1, t
             t = t + exponential(state, inc) / bound if bound > 0.0 else math.inf
             if t >= tb:
                 t = tb
