@@ -216,6 +216,46 @@ def test_a_batch_member_equals_the_same_realisation_run_alone_bit_for_bit(simula
     assert simulated["batch"]["equal"] == [True, True, True]
 
 
+def test_a_thermal_run_with_junction_aging_draws_and_relaxes_the_same_hop_after_the_same_redraws(numba_cuda, tmp_path):
+    # a run file of each backend: the junctions drawn at the start and pushed to the device, the kinetic Monte Carlo
+    # on the host (77 redraws, each changing the yield strains the device holds, then a hop), the hop relaxed on the
+    # device: the same events and junctions as the structured backend, times and stresses to round-off. One load
+    # increment: the event increment's renewals relax for minutes on the simulator (their minimisations are those
+    # of the checks above)
+    result = _run(f"""
+    from stickslip.fem.run import run_simulation
+    from stickslip.formats.fem_run import RunFile, read_increments
+    from stickslip.h5io import open_file
+
+    values = dict(N=9, plates=2, seed=1, relaxation="exact", temperature=1e-3,
+                  drive_rate=2e-8, junction_strengthening=5.0, max_increments=1)
+    mesh = build_stack_mesh(MeshParams(N=9, plates=2))
+    out = {{}}
+    for backend in ("structured", "cuda"):
+        path = {str(tmp_path)!r} + "/" + backend + ".h5"
+        run_simulation(FemParams(**values, backend=backend), path, mesh, make_backend(backend), producer=("fem", "test"))
+        table = read_increments(path)
+        with open_file(path, "r") as file:
+            run = RunFile(file)
+            junctions = [run.state(i)[4] for i in range(run.nstored)]
+        out[backend] = {{
+            "events": table[["kick", "hop_block", "hop_direction", "failed_hops", "redraws", "redraw_block", "S_a1",
+                             "A_a1"]].to_numpy().tolist(),
+            "wells": [j["junction_well"].tolist() for j in junctions],
+            "depths": np.array([j["junction_depth"] for j in junctions]),
+            "floats": table[["t", "sigd", "epsd"]].to_numpy()}}
+    cpu, gpu = out["structured"], out["cuda"]
+    print(json.dumps({{"events": [cpu["events"], gpu["events"]], "wells": cpu["wells"] == gpu["wells"],
+                      "depths": float(np.abs(cpu["depths"] - gpu["depths"]).max()),
+                      "floats": float((np.abs(cpu["floats"] - gpu["floats"]) / np.abs(cpu["floats"]).max(axis=0)).max())}}))
+    """)
+    cpu, gpu = result["events"]
+    assert cpu == gpu
+    assert cpu[1][1] >= 0 and cpu[1][4] > 10  # a hop after redraws: the run has both to compare
+    assert result["wells"] and result["depths"] == 0.0  # the junctions: drawn on the host from the same streams
+    assert result["floats"] < ROUND_OFF
+
+
 def test_the_cuda_backend_without_a_gpu_is_one_line_before_any_file_is_touched(tmp_path, capsys):
     from stickslip.cli import main
     from stickslip.fem.backends.cuda import CudaBackend
@@ -242,7 +282,12 @@ solvers:
     - params: {N: 9, max_increments: 1, backend: cuda, relaxation: exact}  # the linear response by one solve
       grid:
         plates: [2]
-        seed: [1, 2, 3]
+        seed: [1, 2]
+    - params: {N: 9, max_increments: 1, backend: cuda, relaxation: exact, temperature: 1.0e-3, drive_rate: 2.0e-8,
+               junction_strengthening: 5.0}  # a thermal run with junction aging in the same batches
+      grid:
+        plates: [2]
+        seed: [3]
     - params: {N: 9, max_increments: 1}
       grid:
         plates: [2]
@@ -254,8 +299,9 @@ figures: {}
 
 
 def test_a_gpu_batch_is_one_job_that_writes_every_run_s_usual_file(numba_cuda, tmp_path):
-    # three runs of fem on the GPU in batches of at most 2 (one job each), beside a CPU run; on the simulator, one
-    # load increment each: the files, records and database rows are the usual ones
+    # three runs of fem on the GPU in batches of at most 2 (one job each; a thermal run with junction aging among
+    # them), beside a CPU run; on the simulator, one load increment each: the files, records and database rows are the
+    # usual ones
     from conftest import copy_workflow
     from test_workflow import planned_jobs, snakemake
 
@@ -280,6 +326,10 @@ def test_a_gpu_batch_is_one_job_that_writes_every_run_s_usual_file(numba_cuda, t
                           for (params,) in db.execute("SELECT r.params FROM runs AS r JOIN simulations AS s "
                                                       "ON s.run_id = r.run_id"))
     assert backends == ["cuda", "cuda", "cuda", "structured"]
+    with sqlite3.connect(results / "stickslip.sqlite") as db:
+        temperatures = sorted(json.loads(params).get("temperature", 0.0) for (params,) in db.execute(
+            "SELECT r.params FROM runs AS r JOIN simulations AS s ON s.run_id = r.run_id"))
+    assert temperatures == [0.0, 0.0, 0.0, 1e-3]
 
 
 def test_an_ensemble_computes_a_linear_response_in_a_batch_of_the_elastic_law(numba_cuda):
