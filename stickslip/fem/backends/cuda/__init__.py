@@ -2,8 +2,8 @@
 
 A run's state lives in one slot of a :class:`.batch.DeviceBatch` on the device; the backend of the
 run (:class:`CudaBackend`) implements the seam of :mod:`..base` on that slot. A minimisation is one
-or more launches of the minimisation kernel (:mod:`.kernels`), each advancing up to
-:data:`.batch.STEPS_PER_LAUNCH` time steps before the host reads a status word: velocity Verlet, the
+or more launches of the minimisation kernel (:mod:`.minimise`), each advancing up to
+:data:`.launch.STEPS_PER_LAUNCH` time steps before the host reads a status word: velocity Verlet, the
 interface law (the law's own Python functions compiled for the device), the drive, the residual
 criterion, the quiet window and the margin all run there. Runs of one mesh started together
 (:func:`run_ensemble`) share their launches: one launch advances every realisation of the batch,
@@ -15,8 +15,8 @@ order, :mod:`.layout`). Against the CPU the round-off differs (other summation o
 device compiler fuses multiplies and adds): the same events from the same state within the
 reference tolerance, not the same bytes, so ``cuda`` is a value of the ``backend`` parameter with
 its own run ids. The exact relaxation solves on the host (:meth:`CudaBackend.correct`: the force
-out, the correction in, once per Newton iteration). Needs ``numba-cuda`` (``pip install
-stickslip[gpu]``) and a GPU with its driver; ``NUMBA_ENABLE_CUDASIM=1`` runs it on numba's CUDA
+out, the correction in, once per Newton iteration). Needs ``numba-cuda`` (``pip install -e
+".[gpu]"`` in a clone) and a GPU with its driver; ``NUMBA_ENABLE_CUDASIM=1`` runs it on numba's CUDA
 simulator (tests, tiny meshes).
 """
 
@@ -33,7 +33,7 @@ __all__ = ["CudaBackend", "run_ensemble"]
 def _why_not():
     """Why the device cannot be used ("" if it can)."""
     if importlib.util.find_spec("numba_cuda") is None:
-        return "numba-cuda is not installed; install the GPU extra: pip install stickslip[gpu]"
+        return "numba-cuda is not installed; install the GPU extra: pip install -e '.[gpu]' in a clone"
     from numba import cuda  # numba-cuda's target (numba's own is deprecated)
     from numba import config
 
@@ -55,21 +55,22 @@ class CudaBackend(Backend):
     ----------
     threads : int, optional
         Ignored (the device's threads are the kernels' business); kept for the common signature.
-    ensemble : .batch.Ensemble, optional
-        The batch the run belongs to (:func:`run_ensemble`); None: the run has the device to itself.
+    member : .ensemble.Member, optional
+        The run's place in an ensemble (:func:`run_ensemble`): its minimisations share launches with the
+        other members'; None: the run has the device to itself.
     groups : int, optional
-        Blocks a realisation is spread over in a minimisation (default: as many as the device's
-        multiprocessors allow); the results do not depend on it.
+        Blocks a realisation is spread over in a minimisation at most (default: as many as its tiles and the
+        device allow, :class:`.launch.Launcher`); the results do not depend on it.
     """
 
     name = "cuda"
     summary = "NVIDIA GPU (numba-cuda): whole minimisations on the device, batches of runs in one launch"
 
-    def __init__(self, threads=1, ensemble=None, groups=None):
+    def __init__(self, threads=1, member=None, groups=None):
         self.threads = int(threads)
-        self.ensemble = ensemble
+        self.member = member
         self.groups = groups
-        self.model = self.batch = self.slot = None
+        self.model = self.batch = self.slot = self.mesh = None
         self.device_mesh = None
 
     @classmethod
@@ -77,23 +78,25 @@ class CudaBackend(Backend):
         return _why_not()
 
     def prepare(self, model, mesh):
-        from .batch import DeviceBatch, DeviceMesh  # numba-cuda is optional: imported when a run asks for it
+        from .batch import DeviceBatch  # numba-cuda is optional: imported when a run asks for it
+        from .device import DeviceMesh
 
-        if self.ensemble is not None:
-            batch = self.ensemble.batch_for(model)
-        else:
-            batch = DeviceBatch(self.device_mesh or DeviceMesh(model), model.law, 1, self.groups)
-        return self.bound(model, batch)
+        if self.member is not None:
+            return self.bound(model, mesh, self.member.ensemble.batch_for(model, mesh))
+        return self.bound(model, mesh, DeviceBatch(self.device_mesh or DeviceMesh(model, mesh), model.law, 1,
+                                                   self.groups))
 
     def for_model(self, model):
         from .batch import DeviceBatch
 
-        return self.bound(model, DeviceBatch(self.batch.mesh, model.law, 1, self.groups))
+        if self.member is not None:
+            return self.bound(model, self.mesh, self.member.ensemble.batch_for(model, self.mesh))
+        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups))
 
-    def bound(self, model, batch):
-        """A backend for ``model`` in a free slot of ``batch``, at rest at the origin."""
-        bound = CudaBackend(self.threads, self.ensemble, self.groups)
-        bound.model, bound.batch, bound.device_mesh = model, batch, batch.mesh
+    def bound(self, model, mesh, batch):
+        """A backend for ``model`` on ``mesh`` in a free slot of ``batch``, at rest at the origin."""
+        bound = CudaBackend(self.threads, self.member, self.groups)
+        bound.model, bound.mesh, bound.batch, bound.device_mesh = model, mesh, batch, batch.mesh
         bound.slot = batch.attach(model, bound)
         bound.set_state(np.zeros(model.ndof), np.zeros(model.layer_volume.size), 0.0, 0.0)
         return bound
@@ -141,11 +144,11 @@ class CudaBackend(Backend):
         self.batch.rollback(self.slot, token)
 
     def minimise(self, tol, niter_tol, max_iter, margin, record, quiet=0):
-        return self.batch.minimise(self.slot, tol, niter_tol, max_iter, margin, record, quiet)
+        return self.batch.minimise(self.slot, (tol, niter_tol, max_iter, margin, record, quiet), self.member)
 
     def advance(self, nsteps):
         # no stopping criterion: a tolerance no residual is below, no margin, no quiet window
-        self.batch.minimise(self.slot, 0.0, 1, nsteps, 0, False, 0)
+        self.batch.minimise(self.slot, (0.0, 1, nsteps, 0, False, 0), self.member)
 
     def residual(self):
         return self.batch.residual(self.slot)
@@ -163,7 +166,7 @@ def run_ensemble(runs, groups=None):
         ``run(backend)`` makes one run with the backend it is given (e.g. a closure over
         :func:`stickslip.fem.run.run_simulation` with its parameters and output file).
     groups : int, optional
-        Blocks per realisation (default: spread over the device).
+        Blocks per realisation at most (default: spread over the device).
 
     Returns
     -------
@@ -175,21 +178,19 @@ def run_ensemble(runs, groups=None):
     BaseException
         The first error of a run, after every run ended (the others are not interrupted).
     """
-    from .batch import Ensemble
+    from .ensemble import Ensemble
 
     ensemble = Ensemble(len(runs), groups)
+    members = [ensemble.join() for _ in runs]  # every run is a member before any minimisation is launched
     results, errors = [None] * len(runs), [None] * len(runs)
-    joined = threading.Barrier(len(runs)) if runs else None
 
     def one(i):
-        ensemble.join()
-        joined.wait()  # every run is a participant before any minimisation is launched
         try:
-            results[i] = runs[i](CudaBackend(ensemble=ensemble))
+            results[i] = runs[i](CudaBackend(member=members[i], groups=groups))
         except BaseException as error:  # reported after the others ended
             errors[i] = error
         finally:
-            ensemble.leave()
+            members[i].leave()
 
     threads = [threading.Thread(target=one, args=(i,), name=f"cuda-run-{i}") for i in range(len(runs))]
     for thread in threads:
