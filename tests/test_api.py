@@ -1,6 +1,7 @@
 """The public API (stickslip.simulate, open_run, study, plugins, params) gives what the command line gives."""
 
 import hashlib
+import inspect
 import io
 import math
 import subprocess
@@ -302,7 +303,7 @@ def test_the_public_surface_and_a_light_import():
     modules = {path.stem for path in Path(stickslip.__file__).parent.iterdir()
                if path.suffix == ".py" or (path / "__init__.py").is_file()}
     assert not modules & set(stickslip.__all__), modules & set(stickslip.__all__)
-    assert all(getattr(stickslip, name).__module__ == "stickslip.api" for name in stickslip.__all__[1:])
+    assert all(inspect.isfunction(getattr(stickslip, name)) for name in stickslip.__all__[1:])
     probe = ("import sys, stickslip\n"
              "print(sorted(m for m in ('numba', 'matplotlib', 'sqlalchemy', 'stickslip.fem', 'stickslip.solvers.fem')"
              " if m in sys.modules))")

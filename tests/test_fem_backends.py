@@ -13,7 +13,7 @@ from stickslip import registry
 from stickslip.fem.backends import BACKENDS, make_backend
 from stickslip.fem.backends.cpu import StructuredBackend
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.run import run_simulation
+from stickslip.fem.run import simulate_to_file
 from stickslip.fem.simulation import Simulation
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.plugin_params import params_to_dict, parse_params
@@ -52,7 +52,7 @@ def test_the_backend_is_a_parameter_that_makes_its_own_run_id_and_the_default_le
     assert registry.run_id(plugin, assembled) != registry.run_id(plugin, default)
     assert set(BACKENDS) == {"structured", "assembled", "cuda"}
     with pytest.raises(ValueError, match="backend 'assembled' given for a run whose parameter 'backend' is"):
-        run_simulation(default, "unused.h5", build_stack_mesh(MeshParams(N=9)), make_backend("assembled"),
+        simulate_to_file(default, "unused.h5", build_stack_mesh(MeshParams(N=9)), make_backend("assembled"),
                        producer=("fem", "x"))
 
 

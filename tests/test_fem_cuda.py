@@ -223,7 +223,7 @@ def test_a_thermal_run_with_junction_aging_draws_and_relaxes_the_same_hop_after_
     # increment: the event increment's renewals relax for minutes on the simulator (their minimisations are those
     # of the checks above)
     result = _run(f"""
-    from stickslip.fem.run import run_simulation
+    from stickslip.fem.run import simulate_to_file
     from stickslip.formats.fem_run import RunFile, read_increments
     from stickslip.h5io import open_file
 
@@ -233,7 +233,7 @@ def test_a_thermal_run_with_junction_aging_draws_and_relaxes_the_same_hop_after_
     out = {{}}
     for backend in ("structured", "cuda"):
         path = {str(tmp_path)!r} + "/" + backend + ".h5"
-        run_simulation(FemParams(**values, backend=backend), path, mesh, make_backend(backend), producer=("fem", "test"))
+        simulate_to_file(FemParams(**values, backend=backend), path, mesh, make_backend(backend), producer=("fem", "test"))
         table = read_increments(path)
         with open_file(path, "r") as file:
             run = RunFile(file)

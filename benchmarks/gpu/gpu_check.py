@@ -160,14 +160,14 @@ def part_sanity(out):
 def _reference_run(path):
     from stickslip.fem.backends.cuda import CudaBackend
     from stickslip.fem.parameters import FemParams
-    from stickslip.fem.run import run_simulation
+    from stickslip.fem.run import simulate_to_file
     from stickslip.mesh import MeshParams, build_stack_mesh
 
     params = FemParams(N=9, plates=2, seed=0, k_drive=1e-3, drive="fixed-lever", nchunk=200, yield_strains="stop",
                        max_increments=SIZES["reference_increments"], relaxation=SIZES["relaxation"],
                        quiet_steps=SIZES["quiet_steps"], backend="cuda")
     start = time.perf_counter()
-    run_simulation(params, path, build_stack_mesh(MeshParams(N=9, plates=2)), CudaBackend(groups=1),
+    simulate_to_file(params, path, build_stack_mesh(MeshParams(N=9, plates=2)), CudaBackend(groups=1),
                    producer=PRODUCER)
     return time.perf_counter() - start
 
@@ -177,7 +177,7 @@ def part_fidelity(out):
 
     from stickslip.fem.backends.cuda import CudaBackend, run_ensemble
     from stickslip.fem.parameters import FemParams
-    from stickslip.fem.run import run_simulation
+    from stickslip.fem.run import simulate_to_file
     from stickslip.fem.stiffness import PAPER_PHI
     from stickslip.formats.fem_run import read_increments
     from stickslip.mesh import MeshParams, build_stack_mesh
@@ -210,10 +210,10 @@ def part_fidelity(out):
 
     start = time.perf_counter()
     for seed in seeds:
-        run_simulation(params(seed), directory / f"alone-{seed}.h5", mesh, CudaBackend(), producer=PRODUCER)
+        simulate_to_file(params(seed), directory / f"alone-{seed}.h5", mesh, CudaBackend(), producer=PRODUCER)
     alone = time.perf_counter() - start
     start = time.perf_counter()
-    run_ensemble([lambda backend, seed=seed: run_simulation(params(seed), directory / f"batch-{seed}.h5", mesh, backend,
+    run_ensemble([lambda backend, seed=seed: simulate_to_file(params(seed), directory / f"batch-{seed}.h5", mesh, backend,
                                                             producer=PRODUCER) for seed in seeds])
     equal = [(directory / f"alone-{seed}.h5").read_bytes() == (directory / f"batch-{seed}.h5").read_bytes()
              for seed in seeds]

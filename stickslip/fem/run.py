@@ -38,7 +38,7 @@ from .parameters import stored_params
 from .simulation import Simulation
 from .stiffness import driving_regime, stiffness_ratio
 
-__all__ = ["run_simulation"]
+__all__ = ["simulate_to_file"]
 
 #: Free space kept beyond one increment's chunks [B]: HDF5 crashes if a write for lack of space
 #: fails in the file appended to, so the loop stops cleanly (OutputError) before the disk is full.
@@ -128,7 +128,7 @@ def _stored(output, params):
     return completed
 
 
-def run_simulation(params, output, mesh, backend, *, producer):
+def simulate_to_file(params, output, mesh, backend, *, producer):
     """Run (or resume, or skip if completed) one simulation into ``output``.
 
     While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,

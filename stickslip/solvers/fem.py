@@ -14,7 +14,7 @@ from ..fem.backends import make_backend
 from ..fem.backends.cuda import CudaBackend, run_ensemble
 from ..fem.parameters import FemParams
 from ..fem.replay import EventReplay
-from ..fem.run import run_simulation
+from ..fem.run import simulate_to_file
 from ..h5io import FileFormatError
 from ..mesh import MeshParams, build_stack_mesh, read_mesh
 
@@ -78,5 +78,5 @@ def run(params, output, *, threads=1, inputs=None, backend=None):
     ``backend``: a backend object of ``params.backend`` to run on (a GPU batch's,
     :func:`stickslip.workflow_api.run_simulation_batch`); default: a new one.
     """
-    run_simulation(params, output, stack_mesh(params, inputs), backend or make_backend(params.backend, threads),
+    simulate_to_file(params, output, stack_mesh(params, inputs), backend or make_backend(params.backend, threads),
                    producer=("fem", VERSION))
