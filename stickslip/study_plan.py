@@ -34,7 +34,7 @@ import json
 import re
 from pathlib import Path
 
-from . import registry
+from . import mesh, registry
 from .hashing import short_hash
 from .lineage import Artifact
 from .plugin_params import ParameterError, json_schema, params_to_dict, parse_params
@@ -335,8 +335,6 @@ def check_sweeps(config):
 
 def _mesh_for(params):
     """Return (mesh_id, mesh parameters) for a solver run: the solver's fields named as MeshParams fields."""
-    from . import mesh
-
     fields = {f.name for f in dataclasses.fields(mesh.MeshParams)}
     mesh_params = parse_params(mesh.MeshParams, {k: v for k, v in params.items() if k in fields}, owner="mesh")
     return mesh.mesh_id(mesh_params), params_to_dict(mesh_params)
@@ -553,9 +551,7 @@ class Study:
     def code(kind, name):
         """Return the code hash of a plugin (``kind`` "mesh" for the mesh writer)."""
         if kind == "mesh":
-            from .mesh import write_mesh
-
-            return code_hash(write_mesh.__module__)
+            return code_hash(mesh.write_mesh.__module__)
         return code_hash(registry.get(kind, registry.config_key(name)[0]).module)
 
     @staticmethod

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import yaml
 
+from . import registry
 from .errors import RunNotFoundError, StudyNotFoundError
 from .h5io import FileFormatError
 from .provenance import query
@@ -44,8 +45,6 @@ def _read_config(path):
 
 def _plugin_units(frame):
     """Units of the ``params.<name>`` columns of a runs table: the units its plugins declare."""
-    from . import registry
-
     units = {}
     for kind, plugin in frame[["kind", "plugin"]].drop_duplicates().itertuples(index=False):
         try:

@@ -174,7 +174,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache="shared"):
     """
     prepare_environment(1, numba_cache)
     with _logged(log):
-        from . import mesh
+        from . import mesh  # after prepare_environment: numba reads its threads and cache on import
 
         params = parse_params(mesh.MeshParams, json.loads(params_json), owner="mesh")
         as_dict = params_to_dict(params)
@@ -208,7 +208,7 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
     """
     prepare_environment(threads, numba_cache)
     with _logged(log):
-        from .numba_options import set_num_threads
+        from .numba_options import set_num_threads  # after prepare_environment: numba reads its threads on import
 
         job = _solver_job(solver, params_json, output, record, inputs, module)
         if job is not None:
@@ -472,7 +472,7 @@ def build_database(records, database, log):
     log : str or pathlib.Path
     """
     with _logged(log):
-        from .provenance.ingest import ingest
+        from .provenance.ingest import ingest  # SQLAlchemy's ORM (~0.3 s), for the database job only
 
         counts = ingest(database, records, rebuild=True)
         print("ingested " + ", ".join(f"{count} {name}" for name, count in counts.items()))

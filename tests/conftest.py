@@ -1,5 +1,6 @@
 """Shared fixtures: the toy plugin distribution (entry points) and a workflow copy; test groups for pytest-xdist."""
 
+import importlib.util
 import json
 import os
 import shutil
@@ -56,6 +57,16 @@ def toy_plugins(toy_distribution, monkeypatch):
     monkeypatch.syspath_prepend(str(toy_distribution))
     monkeypatch.setattr(registry, "_loaded", False)
     return toy_distribution
+
+
+@pytest.fixture(scope="module")
+def numba_cuda():
+    """numba-cuda is installed: else skip, or fail where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set (as .ci/run does)."""
+    if importlib.util.find_spec("numba_cuda") is None:
+        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
+        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
+            pytest.fail(reason)
+        pytest.skip(reason)
 
 
 @pytest.fixture(autouse=True)

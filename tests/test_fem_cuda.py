@@ -13,7 +13,6 @@ where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set, as .ci/run does); the checks that
 benchmarks/gpu/ (docs/benchmarks.md).
 """
 
-import importlib.util
 import json
 import os
 import subprocess
@@ -23,16 +22,6 @@ import textwrap
 import pytest
 
 pytestmark = pytest.mark.slow
-
-
-@pytest.fixture(scope="module")
-def numba_cuda():
-    """numba-cuda is installed (skip, or fail where .ci/run requires it)."""
-    if importlib.util.find_spec("numba_cuda") is None:
-        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
-        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
-            pytest.fail(reason)
-        pytest.skip(reason)
 
 
 def _run(script, timeout=1800, simulator=True):

@@ -14,7 +14,6 @@ Python with a time limit, so a hang fails it. The checks, each against the same 
   the barrier's deadline ends the launch with an error, not a hang.
 """
 
-import importlib.util
 import json
 import os
 import subprocess
@@ -23,19 +22,10 @@ import textwrap
 
 import pytest
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.usefixtures("numba_cuda")]
 
 #: Seconds a check may take (a hang fails it).
 TIMEOUT = int(os.environ.get("STICKSLIP_CUDA_SIM_TIMEOUT", "900"))
-
-
-@pytest.fixture(scope="module", autouse=True)
-def numba_cuda():
-    if importlib.util.find_spec("numba_cuda") is None:
-        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
-        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
-            pytest.fail(reason)
-        pytest.skip(reason)
 
 
 PRELUDE = """

@@ -58,7 +58,7 @@ def load_aging_runs(paths):
     pandas.DataFrame
         ``file``, ``trials`` (the analysis's ``hold_interfaces``: the runs it made trials in; a study may
         analyse its runs with several parameterisations), ``n``, ``seed``, ``temperature``, ``drive_rate``, ``strengthening`` (0 without aging), ``T0`` and
-        ``data`` (:class:`.results.AnalysisFile`); only thermal runs.
+        ``data`` (:class:`.analysis_files.AnalysisFile`); only thermal runs.
     """
     rows = []
     for path in sorted(map(str, paths)):

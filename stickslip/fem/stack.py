@@ -1,27 +1,21 @@
 """The simulated stack: the one face of a state that a backend owns, and the window of yield strains it holds.
 
-Every block's sequence of yield strains is unbounded (:class:`.yield_strains.HeldYieldStrains`);
-the backend holds a window of it and numbers the wells from the window's start. :class:`Stack`
-keeps the two in step: a well's global index is the held index plus the window's offset, and
-with ``yield_strains = extend`` the windows are moved ahead of the Gauss points after every
-relaxation that moved something (:meth:`Stack.relax`, :meth:`Stack.hold_wells_ahead`), always
-through the backend (:meth:`.backends.base.Backend.set_yield_strains`).
-
-The rest of the package reads and changes the state only through the stack: its backend is private
-(a test greps the package for reach-throughs). What the stack holds may be modified by one
-**yield-strain modifier** that a protocol registers (:meth:`Stack.modify_yield_strains`; junction aging,
-:class:`.thermal.junctions.Junctions`): an object with ``modify(wells)`` (the yield strains the
-backend holds, float64 [ni, ny], from the windows), ``stored()`` (a dict of arrays, its state) and
-``restore(stored)``. A stored state then includes the modifier's state as a fifth item. The stack
-imports nothing of the protocols.
+The rest of the package reads and changes the state only through :class:`Stack`: its backend is private
+(a test greps the package for reach-throughs). The yield strains the backend holds are a window of the
+blocks' unbounded sequences (:class:`.window.HeldWindow`): a well's global index is the held index plus
+the window's offset, and with ``yield_strains = extend`` the windows are moved ahead of the Gauss points
+after every relaxation that moved something (:meth:`Stack.relax`). What the backend holds may be modified
+by one **yield-strain modifier** that a protocol registers (:meth:`Stack.modify_yield_strains`; junction
+aging): a stored state then includes the modifier's state as a fifth item. The stack imports nothing of
+the protocols.
 """
 
 import numpy as np
 
 from .errors import SolverError
 from .laws import make_law
-from .materials import equivalent_strains
 from .model import build_model
+from .window import HeldWindow
 from .yield_strains import HeldYieldStrains, interface_initstate
 
 __all__ = ["Stack", "stack_model"]
@@ -44,38 +38,28 @@ class Stack:
     wells : HeldYieldStrains
         The held windows of the blocks' yield-strain sequences.
     extend : bool
-        ``yield_strains = extend``: the windows follow the Gauss points (else they hold the whole sequence).
-
-    Attributes
-    ----------
-    wells : HeldYieldStrains
-        The held windows (read them; the stack moves them).
-    extend : bool
+        ``yield_strains = extend``: the windows follow the Gauss points (else they hold the whole sequence); an
+        attribute of the same name.
     """
 
     def __init__(self, backend, wells, extend):
         self._backend = backend
-        self.wells = wells
+        self._window = HeldWindow(backend, wells)
         self.extend = extend
-        self._modifier = None
+
+    @property
+    def wells(self):
+        """The held windows (:class:`HeldYieldStrains`: read them; the stack moves them)."""
+        return self._window.wells
 
     def modify_yield_strains(self, modifier):
-        """Register the yield-strain modifier (module docstring); the backend is given its yield strains at once.
-
-        Raises
-        ------
-        ValueError
-            If a modifier is registered already (a stored state holds one modifier's state).
-        """
-        if self._modifier is not None:
-            raise ValueError(f"the stack's yield strains are modified by {self._modifier!r} already")
-        self._modifier = modifier
-        self.push_yield_strains()
+        """Register the yield-strain modifier (:mod:`.window`); the backend is given its yield strains at once."""
+        self._window.register(modifier)
 
     @property
     def modifier(self):
         """The registered yield-strain modifier (None: none)."""
-        return self._modifier
+        return self._window.modifier
 
     @property
     def time(self):
@@ -121,27 +105,22 @@ class Stack:
         and with a modifier its state (``stored()``) as a fifth item."""
         u, target, lever, t = self._backend.read("u", "target", "lever", "t")
         state = (u.copy(), target.copy(), float(lever[0]), float(t[0]))
-        return state if self._modifier is None else (*state, self._modifier.stored())
+        return state if self.modifier is None else (*state, self.modifier.stored())
 
     def restore(self, u, target, lever_target, t, modified=None):
         """Set a stored state (at rest) and, with ``extend``, move the windows to it (:meth:`hold_wells_ahead`).
 
         Parameters
         ----------
-        u : numpy.ndarray
-            [ndof] displacement.
-        target : numpy.ndarray
-            [nlayer] drive targets (fixed lever; recomputed for a free lever).
-        lever_target : float
-            Free lever: drive target ``x_target``.
-        t : float
-            Time.
+        u, target, lever_target, t
+            A stored state (:meth:`stored`): displacement [ndof], drive targets [nlayer] (recomputed for a free
+            lever), a free lever's drive target, time.
         modified : dict, optional
             The modifier's state (its ``stored()``), set before the displacement.
         """
         if modified is not None:
-            self._modifier.restore(modified)
-            self.push_yield_strains()
+            self.modifier.restore(modified)
+            self._window.push()
         self._backend.set_state(u, target, lever_target, t)
         if self.extend:
             self.hold_wells_ahead()
@@ -184,52 +163,17 @@ class Stack:
         response's elastic twin; :meth:`.backends.base.Backend.for_model`)."""
         return self._backend.for_model(model)
 
-    def push_yield_strains(self, shift=None):
-        """Give the backend the yield strains it holds: the windows, modified (if a modifier is registered).
-
-        Parameters
-        ----------
-        shift : numpy.ndarray, optional
-            int64 [ni]: the windows moved forward by this many values (:meth:`.backends.base.Backend.set_yield_strains`).
-        """
-        epsy = self.wells.epsy if self._modifier is None else self._modifier.modify(self.wells)
-        self._backend.set_yield_strains(epsy, shift)
+    def push_yield_strains(self):
+        """Give the backend the yield strains it holds anew (a modifier's state changed: :meth:`.window.HeldWindow.push`)."""
+        self._window.push()
 
     def widen_wells(self):
         """Hold twice as many wells per block (the window's start unchanged)."""
-        self.wells.widen(self.wells.epsy.shape[1] - 1)
-        self.push_yield_strains()
+        self._window.widen()
 
     def hold_wells_ahead(self):
-        """``yield_strains = extend``: hold at least half a window of wells ahead of every Gauss point.
-
-        A block with fewer than ``(ny - 1) // 2`` held wells ahead of its furthest Gauss
-        point has its window moved forward to start ``(ny - 1) // 4`` wells behind its
-        nearest one (or widened if its points are spread too far for that). A state
-        beyond the held wells (after :meth:`restore`) is followed to its wells; a state
-        behind them restarts the windows from the origin. The values held never change
-        the physics: they are the same numbers wherever the window is.
-        """
-        wells = self.wells
-        idx, eps = self._backend.read("idx", "eps")
-        if np.any((wells.offset > 0) & (idx.min(axis=1) == 0)
-                  & (equivalent_strains(eps).min(axis=1) <= wells.epsy[:, 0])):
-            wells.start(wells.epsy.shape[1] - 1)
-            self.push_yield_strains()
-        while True:
-            ny = wells.epsy.shape[1]
-            ahead, behind = (ny - 1) // 2, (ny - 1) // 4
-            idx, eps = self._backend.read("idx", "eps")
-            short = idx.max(axis=1) > ny - 1 - ahead
-            if not short.any():
-                return
-            beyond = equivalent_strains(eps).max(axis=1) > wells.epsy[:, -1]
-            shift = np.where(short, np.where(beyond, ny - 1 - behind, idx.min(axis=1) - behind), 0)
-            if np.any(short & (shift <= 0)):
-                self.widen_wells()
-                continue
-            wells.slide(shift)
-            self.push_yield_strains(shift)
+        """Hold at least half a window of wells ahead of every Gauss point (:meth:`.window.HeldWindow.hold_ahead`)."""
+        self._window.hold_ahead()
 
 
 def stack_model(params, mesh, constants):
