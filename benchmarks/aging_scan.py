@@ -40,7 +40,7 @@ from stickslip.figures import experimental_data
 from stickslip.figures.experimental_panels import single_slips
 from stickslip.figures.figs_aging_recovery import recovery, run_pairs
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 #: (rs_a, rs_b): b - a = 0.006 from a = 0.005 (the published smooth-PMMA direct effect) to 0.022, and a = 0.013
 #: with b - a = 0.003 to 0.012.

@@ -52,7 +52,7 @@ from stickslip.fem.event_driven import autoscale
 from stickslip.fem.linear_response import LinearResponse
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.simulation import Simulation
-from stickslip.fem.stack import build_stack
+from stickslip.fem.stack import stack_model
 from stickslip.fem.yield_strains import interface_initstate, narrowest_well
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.numba_options import njit, set_num_threads
@@ -64,12 +64,13 @@ SMALL = 10
 def affine_response(params, mesh):
     """An affine simple shear (gamma = eps0) as the loading direction, scaled like the true response (timing only:
     no solve; computed on the host's ``structured`` backend, whatever ``params.backend``)."""
-    stack = build_stack(params, mesh, make_backend(), derived_constants(params, mesh))
-    u = np.zeros(stack.model.ndof)
+    model, _ = stack_model(params, mesh, derived_constants(params, mesh))
+    backend = make_backend().prepare(model, mesh)
+    u = np.zeros(model.ndof)
     u[mesh.dofs[:, 0]] = 2.0 * params.eps0 * mesh.coor[:, 1]
     target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height)
-    stack.backend.set_state(u, target, 0.0, 0.0)
-    eps = stack.backend.read("eps")[0].copy()
+    backend.set_state(u, target, 0.0, 0.0)
+    eps = backend.read("eps")[0].copy()
     scale = autoscale(narrowest_well(interface_initstate(params.seed, mesh.N, mesh.n_interfaces), params.nchunk,
                                      params.eps0, params.eps_offset, params.weibull_k), eps)
     return LinearResponse(scale * u, scale * eps, scale * target, 0.0)
@@ -80,14 +81,14 @@ def _loaded_simulation(args, mesh, threads, backend):
     params = FemParams(N=args.N, plates=args.plates, nchunk=200, backend=backend)
     sim = Simulation(params, mesh, make_backend(backend, threads), response=affine_response(params, mesh))
     sim.loading.step(kick=False)
-    index = sim.stack.backend.read("idx")[0].copy()
+    index = sim.backend.read("idx")[0].copy()
     sim.loading.step(kick=True)
     return sim, index
 
 
 def _time_steps(args, mesh, threads, backend):
     sim, index = _loaded_simulation(args, mesh, threads, backend)
-    cpu_backend = sim.stack.backend
+    cpu_backend = sim.backend
     cpu_backend.advance(10)  # warm up (compiles if not cached)
     start, cpu = time.perf_counter(), time.process_time()
     cpu_backend.advance(args.steps)
@@ -144,7 +145,7 @@ def _breakdown(args, mesh, threads):
                   ("predict", _repeat_predict), ("correct", _repeat_correct), ("residual", _repeat_residual))
     repeat = max(1, args.steps // 4)
     for backend in ("assembled", "structured"):
-        cpu_backend = _loaded_simulation(args, mesh, threads, backend)[0].stack.backend
+        cpu_backend = _loaded_simulation(args, mesh, threads, backend)[0].backend
         model, work, state = cpu_backend.model, cpu_backend.work, cpu_backend.state
         parts = []
         for name, kernel in components:
@@ -171,7 +172,7 @@ def _events(sim, count):
     """Run ``count`` events; returns arrays (steps, seconds, A, CPU seconds of this process) per event."""
     steps, seconds, sizes, cpu = [], [], [], []
     stack = sim.stack
-    dt = stack.model.dt
+    dt = sim.model.dt
     for _ in range(count):
         sim.loading.step(kick=False)
         before = stack.well_index()[:, 0]
@@ -239,7 +240,7 @@ def _compile_kernels():
 
 def _solve_mode(args, mesh, threads):
     params = FemParams(N=args.N, plates=args.plates, k_drive=args.k_drive, relaxation="exact")
-    model = build_stack(params, mesh, make_backend("structured", threads), derived_constants(params, mesh)).model
+    model, _ = stack_model(params, mesh, derived_constants(params, mesh))
     start = time.process_time()
     equilibrium = WellEquilibrium(model)
     factorised = time.process_time() - start

@@ -20,7 +20,7 @@ from stickslip.fem.backends import make_backend
 from stickslip.fem.backends.cpu import minimise
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.simulation import Simulation
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.solvers.fem import stack_mesh
 
 #: One call for any minimisation: more time steps than any run makes.

@@ -15,7 +15,7 @@ import numpy as np
 
 from stickslip.experiment.virtual import Apparatus
 from stickslip.experiment.virtual.slab_dynamics import METHODS, SlabDynamics
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.experiment.virtual.rate_state_model import law_of
 from stickslip.solvers.rate_state_lever import RateStateLeverParams
 

@@ -27,7 +27,7 @@ from stickslip.h5io import open_file
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.replay import EventReplay
 from stickslip.fem.thermal import drive_scale, energy_unit, sample_event
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.registry import get
 
 
@@ -55,8 +55,8 @@ def draw_cost(path, draws):
     sim = replay.simulation
     with open_file(path) as file:
         sim.stack.restore(*RunFile(file).state(replay.nstored - 1))
-    p, model = sim.params, sim.stack.model
-    idx, eps = sim.stack.backend.read("idx", "eps")
+    p, model = sim.params, sim.model
+    idx, eps = sim.backend.read("idx", "eps")
     beta = 1.0 / (p.temperature * energy_unit(p, sim.constants["h"]))
     speed = p.drive_rate / drive_scale(sim.loading.response, p.eps0, sim.mesh)
     ds_c = sim.loading.step_size(False)

@@ -23,7 +23,7 @@ from stickslip import registry
 from stickslip.experiment.aging import fit_aging, spread_of_aging_rate
 from stickslip.figures.experimental_data import EVENTS, load_interfaces, load_slips
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distributions", "figS-aging-variations",
            "figS-slow-slip")

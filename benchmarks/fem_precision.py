@@ -44,7 +44,7 @@ def main(argv=None):
         sim.protocol.kick(params.margin)
     hops = observer.well_index() - start
     slips = max(int(np.sum(hops.min(axis=1) > 0)), 1)
-    top = float(stack.backend.read("ubar")[0][-1])
+    top = float(stack.read("ubar")[0][-1])
     per_slip = top / max(hops.min(axis=1).sum(), 1)  # top-plate displacement per well hop of a whole interface
     u, target, lever, t = stack.stored()
     x = sim.mesh.dofs[:, 0]
@@ -57,12 +57,12 @@ def main(argv=None):
         moved = u.copy()
         moved[np.unique(x)] += T
         stack.restore(moved, target + T, lever, t)
-        r = stack.backend.residual()
+        r = sim.backend.residual()
         row = observer.observe(observer.well_index())
         dsig = abs(row["sigd"] / base["sigd"] - 1.0)
         drive = [k for k in row if k.startswith("fxdrive_") and base[k] != 0.0]
         dfx = max(abs(row[k] / base[k] - 1.0) for k in drive)
-        solved = sim.relaxation.solve_in_wells(stack.backend)
+        solved = sim.relaxation.solve_in_wells(sim.backend)
         print(f"{T:8.0e} {T / per_slip:10.2e} {r:10.2e} {dsig:10.2e} {dfx:10.2e} {'ok' if solved else 'FAILS'}")
         if floor_T is None and r > 1e-10:
             floor_T = T

@@ -66,7 +66,7 @@ from stickslip.fem.simulation import Simulation
 from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import open_file
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 REFERENCE_CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "nchunk": 200}
 
@@ -99,7 +99,7 @@ def reference(args):
         sim = Simulation(FemParams(**case, relaxation=relaxation), mesh, make_backend(), response=linear)
         start = time.perf_counter()
         out[relaxation] = _increments(sim, 1000)
-        print(f"{relaxation}: {len(out[relaxation])} increments, {sim.stack.time / sim.stack.model.dt:.0f} time "
+        print(f"{relaxation}: {len(out[relaxation])} increments, {sim.stack.time / sim.model.dt:.0f} time "
               f"steps, {time.perf_counter() - start:.1f} s")
     a, b = out["dynamic"], out["exact"]
     n = min(len(a), len(b))
@@ -116,10 +116,10 @@ def reference(args):
     sim = Simulation(FemParams(**case), mesh, make_backend(), response=linear)
     sim.loading.step(False)
     sim.protocol.kick(sim.params.margin)
-    u = sim.stack.backend.read("u")[0].copy()
+    u = sim.backend.read("u")[0].copy()
     exact = Simulation(FemParams(**case, relaxation="exact"), mesh, make_backend(), response=linear).relaxation
-    assert exact.solve_in_wells(sim.stack.backend)
-    distance = np.abs(u - sim.stack.backend.read("u")[0]).max() / np.abs(u).max()
+    assert exact.solve_in_wells(sim.backend)
+    distance = np.abs(u - sim.backend.read("u")[0]).max() / np.abs(u).max()
     print(f"first kick: the dynamic end state is {distance:.2e} "
           f"(relative, max norm) from the exact equilibrium of its own wells")
 
@@ -262,7 +262,7 @@ def stability(args):
     mesh = build_stack_mesh(MeshParams(N=args.N, plates=args.plates))
     params = {"N": args.N, "plates": args.plates, "k_drive": args.k_drive, "relaxation": "exact"}
     sim = Simulation(FemParams(**params), mesh, make_backend())
-    equilibrium, model = sim.relaxation.equilibrium, sim.stack.model
+    equilibrium, model = sim.relaxation.equilibrium, sim.model
     stiffness = equilibrium.matrix  # plates + interfaces with the elastic (stiffest) law, free DOFs
     weight = sparse.diags(np.sqrt(model.mass_inv[equilibrium.free]))
     omega = float(np.sqrt(eigsh(weight @ stiffness @ weight, k=1, which="LA", return_eigenvectors=False)[0]))
@@ -278,8 +278,8 @@ def stability(args):
         trial.stack.restore(*kicked)
         energy = np.empty(args.steps)
         for i in range(args.steps):
-            trial.stack.backend.advance(1)
-            energy[i] = _kinetic_energy(trial.stack.backend)
+            trial.backend.advance(1)
+            energy[i] = _kinetic_energy(trial.backend)
             if not energy[i] < bound:
                 break
         stable = i + 1 == args.steps

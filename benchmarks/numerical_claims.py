@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip.events.extraction import sequence_fractions, slip_fractions
-from stickslip.events.results import read_analysis_file
+from stickslip.events.analysis_files import read_analysis_file
 from stickslip.events.size_series import (GROUP, drop_shift_by_size, front_speed_by_size, periodicity_by_size,
                                           run_key)
 from stickslip.fem.stiffness import at_paper_phi

@@ -26,7 +26,7 @@ import numpy as np
 
 from stickslip.experiment.aging import aging_rate
 from stickslip.experiment.virtual.rate_state_model import simulate
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.solvers.rate_state_lever import RateStateLeverParams
 
 TRANSIENT = 300.0

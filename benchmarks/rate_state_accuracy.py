@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.experiment.virtual.rate_state_model import simulate
 from stickslip.solvers.rate_state_lever import RateStateLeverParams
 

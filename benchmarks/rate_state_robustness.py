@@ -12,7 +12,7 @@ import sys
 import time
 
 from stickslip.experiment.virtual.rate_state_model import simulate
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.solvers.rate_state_lever import RateStateLeverParams
 
 

@@ -30,7 +30,7 @@ from stickslip.experiment.aging import fit_aging, spread_of_aging_rate
 from stickslip.figures import figs_thermal
 from stickslip.figures.experimental_data import load_interfaces, load_slips
 from stickslip.formats.fem_run import read_increments
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 
 def fits(T, dmu, t0):

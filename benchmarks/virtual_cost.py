@@ -16,7 +16,7 @@ import sys
 import time
 
 from stickslip.experiment.virtual.model import simulate as lever_simulate
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.solvers.lever import LeverParams
 from stickslip.experiment.virtual.rate_state_model import simulate as rate_state_simulate
 from stickslip.solvers.rate_state_lever import RateStateLeverParams

@@ -20,11 +20,7 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
-# The modules stickslip.params and stickslip.study share their names with two functions of the API. Importing
-# a submodule for the first time sets the package's attribute of that name: they are imported before the API
-# binds its functions, so that stickslip.params and stickslip.study stay the functions. (Import from those
-# modules, `from stickslip.params import param`, never `from stickslip import params`.)
-from . import params as _params_module, study as _study_module  # noqa: E402, F401
+# after __version__: the API's modules read it (the file formats record the version that wrote them)
 from .api import open_run, params, plugins, simulate, study  # noqa: E402
 
 __all__ = ["__version__", "simulate", "open_run", "study", "plugins", "params"]

@@ -17,7 +17,7 @@ import dataclasses
 import pandas as pd
 
 from . import formats, registry
-from .params import ParameterError, describe
+from .plugin_params import ParameterError, describe
 from .runs import open_run
 from .vocabulary import with_units
 
@@ -58,7 +58,7 @@ def simulate(solver, output, *, threads=1, overwrite=False, **params):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         A ``ValueError`` naming a bad parameter and what was expected (the command line's message).
     stickslip.registry.PluginError
         If there is no such solver.
@@ -90,7 +90,7 @@ def study(name_or_path="default", *, workdir=None):
 
     Returns
     -------
-    stickslip.results.StudyResults
+    stickslip.study_results.StudyResults
         ``runs(...)``, ``events(...)`` with keyword filters on every parameter (``plates=3, k_drive=...,
         regime="stiff"``), ``figures()``, ``sql(...)`` (typed pandas DataFrames with ``attrs["units"]``, from
         read-only connections, :mod:`stickslip.provenance.query`), ``open_run(run_id)``, ``open_runs(frame)``,
@@ -104,7 +104,7 @@ def study(name_or_path="default", *, workdir=None):
     """
     # Imported here: the database layer (SQLAlchemy and the schema) takes 0.24 s to import, which every command
     # and workflow job would pay, since each imports this package (python -X importtime, 2026-11-26).
-    from .results import StudyResults
+    from .study_results import StudyResults
 
     return StudyResults(name_or_path, workdir=workdir)
 
@@ -127,7 +127,7 @@ def plugins(kind=None):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         A ``ValueError`` for another ``kind``.
     """
     if kind is not None and kind not in LISTED:
@@ -159,7 +159,7 @@ def params(name, kind="solver"):
     -------
     pandas.DataFrame
         Indexed by parameter name, in declaration order: ``type``, ``default``, ``unit`` and ``doc``
-        (:func:`stickslip.params.describe`); ``attrs["units"]`` (of these columns: none; the parameters' own
+        (:func:`stickslip.plugin_params.describe`); ``attrs["units"]`` (of these columns: none; the parameters' own
         units are the column ``unit``).
 
     Raises

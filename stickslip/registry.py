@@ -2,7 +2,7 @@
 
 A plugin is one function plus its identity: name (a path component of its
 outputs), version (part of the run id: a new version reruns what it produced),
-a parameter dataclass (see :mod:`stickslip.params`) and its contract: the
+a parameter dataclass (see :mod:`stickslip.plugin_params`) and its contract: the
 artifact formats it consumes and produces (:mod:`stickslip.formats`); a figure
 declares the input categories it reads. The study wires stages by format, never
 by plugin name: an analysis that consumes ``fem-run`` runs on the output of every
@@ -45,13 +45,14 @@ from importlib.metadata import entry_points
 from . import formats
 from .h5io import FileFormatError
 from .hashing import short_hash
-from .params import params_to_dict
+from .plugin_params import params_to_dict
 
 __all__ = [
     "KINDS",
     "ENTRY_POINT_GROUPS",
     "BUILTIN_PACKAGES",
     "Plugin",
+    "DeviceBatching",
     "PluginError",
     "register",
     "get",
@@ -87,6 +88,31 @@ class PluginError(LookupError):
 
 
 @dataclasses.dataclass(frozen=True)
+class DeviceBatching:
+    """How a solver's runs share one device in batches: a capability a solver declares (``device_batch``).
+
+    The study plans a batch of the runs that :attr:`on_device` picks and that agree on :attr:`shared`
+    (:func:`stickslip.study_plan.device_batches`); one workflow job runs them with :attr:`run`
+    (:func:`stickslip.workflow_api.run_simulation_batch`). Neither names a solver or a backend.
+
+    Attributes
+    ----------
+    on_device : Callable[[Mapping[str, object]], bool]
+        Whether a run of these parameters (defaults filled, :func:`stickslip.plugin_params.params_to_dict`) runs on
+        the device.
+    shared : tuple[str, ...]
+        The parameters that the runs of one batch share (what the device holds once for all of them).
+    run : Callable[[Sequence[Callable]], list]
+        ``run(members)`` runs a batch: every member is ``member(backend)``, one run on the backend it is given,
+        all at once; returns what each returned, in order, after all ended (raises the first error).
+    """
+
+    on_device: Callable
+    shared: tuple
+    run: Callable
+
+
+@dataclasses.dataclass(frozen=True)
 class Plugin:
     """One registered plugin.
 
@@ -115,8 +141,10 @@ class Plugin:
     replay : Callable or None
         Solvers: ``replay(path)`` re-runs stored events of a file the solver wrote.
     preflight : Callable or None
-        Solvers: ``preflight(params)`` raises :class:`stickslip.params.ParameterError` if this machine cannot
+        Solvers: ``preflight(params)`` raises :class:`stickslip.plugin_params.ParameterError` if this machine cannot
         make the run (e.g. a GPU backend without a GPU); called before any output is claimed or written.
+    device_batch : DeviceBatching or None
+        Solvers: how runs share a device in batches (None: every run is one job).
     module : str
         Module that defined it.
     """
@@ -132,6 +160,7 @@ class Plugin:
     inputs: tuple = ()
     replay: Callable | None = None
     preflight: Callable | None = None
+    device_batch: DeviceBatching | None = None
     module: str = ""
 
 
@@ -184,10 +213,18 @@ def _check_contract(plugin):
         raise PluginError(f"{where}: only figures declare inputs=(...); solvers and analyses declare consumes")
     if plugin.replay is not None and (plugin.kind != "solver" or not callable(plugin.replay)):
         raise PluginError(f"{where}: replay must be a callable of a solver")
+    if plugin.device_batch is not None:
+        batching = plugin.device_batch
+        if plugin.kind != "solver" or not isinstance(batching, DeviceBatching):
+            raise PluginError(f"{where}: device_batch must be a DeviceBatching of a solver")
+        fields = {f.name for f in dataclasses.fields(plugin.params)}
+        unknown = [name for name in batching.shared if name not in fields]
+        if unknown:
+            raise PluginError(f"{where}: device_batch shares parameters it does not have: {', '.join(unknown)}")
 
 
 def register(kind, name, version, params, *, summary="", consumes=(), produces=None, inputs=(), replay=None,
-             preflight=None):
+             preflight=None, device_batch=None):
     """Decorator that registers a plugin function.
 
     Parameters
@@ -201,7 +238,7 @@ def register(kind, name, version, params, *, summary="", consumes=(), produces=N
         Parameter dataclass.
     summary : str, optional
         One line for listings; defaults to the first line of the docstring.
-    consumes, produces, inputs, replay, preflight
+    consumes, produces, inputs, replay, preflight, device_batch
         The plugin's contract (see :class:`Plugin`).
 
     Returns
@@ -219,7 +256,8 @@ def register(kind, name, version, params, *, summary="", consumes=(), produces=N
         doc = (inspect.getdoc(function) or "").strip().splitlines()
         plugin = Plugin(kind=kind, name=name, version=version, params=params, run=function,
                         summary=summary or (doc[0] if doc else ""), consumes=tuple(consumes), produces=produces,
-                        inputs=tuple(inputs), replay=replay, preflight=preflight, module=function.__module__)
+                        inputs=tuple(inputs), replay=replay, preflight=preflight, device_batch=device_batch,
+                        module=function.__module__)
         _check_shape(plugin)
         existing = _plugins[kind].get(name)
         if existing is not None and (existing.module, existing.run.__qualname__) != (

@@ -31,7 +31,7 @@ from .formats.fem_run import RunFile, read_increments, read_run_attrs
 from .errors import IncrementError
 from .h5io import FileFormatError, attribute, open_file
 from .output_safety.overwrite import root_attributes
-from .params import parse_params
+from .plugin_params import parse_params
 from .vocabulary import with_units
 
 __all__ = ["open_run", "FemRun", "RunState", "TimeseriesRun", "READERS"]
@@ -325,7 +325,7 @@ class TimeseriesRun(_Run):
 
         Raises
         ------
-        stickslip.params.ParameterError
+        stickslip.plugin_params.ParameterError
             A ``ValueError`` naming a bad parameter.
         """
         params = parse_params(ExperimentEventsParams, analysis_params, owner=f"analysis '{EXPERIMENT_EVENTS}'")

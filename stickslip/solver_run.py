@@ -14,7 +14,7 @@ from . import registry
 from .numba_options import set_num_threads
 from .output_safety.atomic import check_output
 from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
-from .params import ParameterError, params_to_dict, parse_params
+from .plugin_params import ParameterError, params_to_dict, parse_params
 
 __all__ = ["run_identity", "run_solver"]
 
@@ -53,7 +53,7 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     ------
     stickslip.registry.PluginError
         If there is no such solver.
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         For an unknown parameter or a bad value (a ``ValueError`` naming the parameter; ``threads`` and
         ``overwrite`` of another type too), or parameters this machine cannot run (the solver's ``preflight``: a
         GPU backend without a GPU), before any file is touched.

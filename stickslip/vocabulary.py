@@ -215,7 +215,7 @@ QUANTITIES = {
     "dmu_mean": _q("float64", "1", "mean friction drop of the bin's slips"),
     "dmu_std": _q("float64", "1", "standard deviation of the friction drops of the bin's slips"),
     "count": _q("int64", "1", "slips in the bin"),
-    # --- the plugins and formats (stickslip.plugins, stickslip.params)
+    # --- the plugins and formats (stickslip.plugins, stickslip.plugin_params)
     "name": _q("str", _LABEL, "name of a plugin, a format or a parameter"),
     "version": _q("str", _LABEL, "version of a plugin or a format"),
     "summary": _q("str", _LABEL, "one line: what the plugin does or the format holds"),

@@ -40,7 +40,7 @@ from .h5io import FileFormatError, open_file
 from .hashing import sha256_file
 from .lineage import Artifact
 from .output_safety.overwrite import refuse_other_run
-from .params import params_to_dict, parse_params
+from .plugin_params import params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import read_record, recording
 from .termination import interrupts_raised
@@ -174,7 +174,7 @@ def run_mesh(params_json, output, record, log, *, numba_cache="shared"):
     """
     prepare_environment(1, numba_cache)
     with _logged(log):
-        from . import mesh
+        from . import mesh  # after prepare_environment: numba reads its threads and cache on import
 
         params = parse_params(mesh.MeshParams, json.loads(params_json), owner="mesh")
         as_dict = params_to_dict(params)
@@ -198,7 +198,7 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
         Simulation file (HDF5), its provenance record, the log.
     inputs : str or Mapping
         Upstream files by consumed format, as artifacts (``{"mesh": Artifact}``), or
-        their JSON (:meth:`stickslip.study.Study.dumps`).
+        their JSON (:meth:`stickslip.study_plan.Study.dumps`).
     threads : int
         Threads of the parallel kernels.
     numba_cache : {"shared", "job"}
@@ -208,7 +208,7 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
     """
     prepare_environment(threads, numba_cache)
     with _logged(log):
-        from .numba_options import set_num_threads
+        from .numba_options import set_num_threads  # after prepare_environment: numba reads its threads on import
 
         job = _solver_job(solver, params_json, output, record, inputs, module)
         if job is not None:
@@ -217,11 +217,12 @@ def run_simulation(solver, params_json, output, record, log, *, inputs, threads,
 
 def run_simulation_batch(solver, params_jsons, outputs, records, log, *, inputs, threads, numba_cache="shared",
                          module=None):
-    """Run several runs of one solver as one batch on a GPU (``backend = cuda``): one job, one file per run.
+    """Run several runs of one solver as one batch on a device: one job, one file per run.
 
     Every run is as :func:`run_simulation` makes it (its file, its provenance record, resumed or left
     alone as there); the runs not completed before advance together, one thread each, their
-    minimisations sharing the device's launches (:func:`stickslip.fem.backends.cuda.run_ensemble`).
+    minimisations sharing the device's launches (the solver's ``device_batch``,
+    :class:`stickslip.registry.DeviceBatching`).
 
     Parameters
     ----------
@@ -237,14 +238,16 @@ def run_simulation_batch(solver, params_jsons, outputs, records, log, *, inputs,
     """
     prepare_environment(threads, numba_cache)
     with _logged(log):
-        from .fem.backends.cuda import run_ensemble
-        from .numba_options import set_num_threads
+        from .numba_options import set_num_threads  # after prepare_environment: numba reads its threads on import
 
+        batching = registry.get("solver", registry.config_key(solver)[0], module).device_batch
+        if batching is None:
+            raise registry.PluginError(f"solver {solver!r} declares no device_batch: its runs are one job each")
         jobs = [_solver_job(solver, *job, module) for job in zip(params_jsons, outputs, records, inputs)]
         pending = [job for job in jobs if job is not None]
         used = set_num_threads(threads)
         print(f"batch of {len(jobs)} runs, {len(jobs) - len(pending)} completed before")
-        run_ensemble([lambda backend, job=job: _run_solver_job(job, used, backend) for job in pending])
+        batching.run([lambda backend, job=job: _run_solver_job(job, used, backend) for job in pending])
 
 
 def _solver_job(solver, params_json, output, record, inputs, module):
@@ -469,7 +472,7 @@ def build_database(records, database, log):
     log : str or pathlib.Path
     """
     with _logged(log):
-        from .provenance.ingest import ingest
+        from .provenance.ingest import ingest  # SQLAlchemy's ORM (~0.3 s), for the database job only
 
         counts = ingest(database, records, rebuild=True)
         print("ingested " + ", ".join(f"{count} {name}" for name, count in counts.items()))

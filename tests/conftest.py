@@ -1,5 +1,6 @@
 """Shared fixtures: the toy plugin distribution (entry points) and a workflow copy; test groups for pytest-xdist."""
 
+import importlib.util
 import json
 import os
 import shutil
@@ -15,7 +16,7 @@ from stickslip import registry
 from stickslip.formats.fem_run import read_increments
 from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
-from stickslip.study import Study
+from stickslip.study_plan import Study
 
 REPO = Path(__file__).resolve().parent.parent
 TOY = Path(__file__).resolve().parent / "toy_plugin" / "stickslip_toy.py"
@@ -56,6 +57,16 @@ def toy_plugins(toy_distribution, monkeypatch):
     monkeypatch.syspath_prepend(str(toy_distribution))
     monkeypatch.setattr(registry, "_loaded", False)
     return toy_distribution
+
+
+@pytest.fixture(scope="module")
+def numba_cuda():
+    """numba-cuda is installed: else skip, or fail where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set (as .ci/run does)."""
+    if importlib.util.find_spec("numba_cuda") is None:
+        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
+        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
+            pytest.fail(reason)
+        pytest.skip(reason)
 
 
 @pytest.fixture(autouse=True)
@@ -133,7 +144,7 @@ def toy_results(tmp_path, toy_plugins, monkeypatch):
     list[pathlib.Path]
         The provenance records, relative to the working directory ``tmp_path``.
     """
-    from stickslip.params import parse_params
+    from stickslip.plugin_params import parse_params
     from stickslip.workflow_api import run_analysis, run_figure, run_simulation
 
     monkeypatch.chdir(tmp_path)
@@ -172,7 +183,7 @@ def fem_reference_run(tmp_path_factory):
     Shared by tests/test_fem_reference.py and tests/test_fem_kill.py, which compare their own runs of the
     case with it byte for byte.
     """
-    from stickslip.params import parse_params
+    from stickslip.plugin_params import parse_params
 
     path = tmp_path_factory.mktemp("fem-reference") / "run.h5"
     plugin = registry.get("solver", "fem")

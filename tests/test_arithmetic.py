@@ -17,7 +17,7 @@ from stickslip.arithmetic import CONTINUE_VARIABLE, ArithmeticMismatchError, dec
 from stickslip.cli import main
 from stickslip.fem.backends import make_backend
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.run import run_simulation
+from stickslip.fem.run import simulate_to_file
 from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.h5io import read_datasets
 from stickslip.mesh import MeshParams, build_stack_mesh
@@ -82,7 +82,7 @@ def test_resume_under_other_packages_is_refused_naming_them_and_continues_when_a
     _interrupt_at(path, 3, {"numpy": "1.26.4", "scipy": "1.11.0"})
     with pytest.raises(ArithmeticMismatchError) as refused:  # the library call refuses as the CLI does
         params = FemParams(N=9, plates=2, relaxation="exact", max_increments=6, nchunk=100)
-        run_simulation(params, path, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend("structured"),
+        simulate_to_file(params, path, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend("structured"),
                        producer=("fem", "4"))
     message = str(refused.value)
     assert "\n" not in message

@@ -9,7 +9,7 @@ from stickslip.cli import main
 from stickslip.experiment.csv_import import import_csv
 from stickslip.experiment.timeseries import read_timeseries
 from stickslip.h5io import FileFormatError
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.experiment.virtual.model import simulate
 from stickslip.solvers.lever import LeverParams
 

@@ -12,7 +12,7 @@ import pytest
 from stickslip.formats.event_table import read_slip_events
 from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from stickslip.provenance import ingest as ingest_module
 from stickslip.provenance import query
 from stickslip.provenance.database import SCHEMA_VERSION, create_schema, engine_for
@@ -154,7 +154,7 @@ def test_queries_are_read_only_and_filter(toy_results):
 def test_ingest_reads_lineage_and_formats_not_paths(tmp_path, toy_plugins, monkeypatch):
     """Files under arbitrary names: events are keyed by the run id the lineage carries."""
     from stickslip import registry
-    from stickslip.study import Study
+    from stickslip.study_plan import Study
     from stickslip.workflow_api import run_analysis, run_simulation
 
     monkeypatch.chdir(tmp_path)

@@ -13,7 +13,7 @@ import pytest
 
 from stickslip import registry
 from stickslip.cli import build_parser
-from stickslip.params import parse_assignments, parse_params
+from stickslip.plugin_params import parse_assignments, parse_params
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]

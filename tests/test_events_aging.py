@@ -20,7 +20,7 @@ from stickslip.events.aging_summary import curvature, driven_aftershocks, paired
 from stickslip.events.omori import bootstrap_omori, fit_omori, omori_rate_integral
 from stickslip.h5io import open_file, read_table
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 
 def _omori_sequences(K, c, p, T, M, seed):

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from stickslip import registry
-from stickslip.events.results import read_analysis_file
+from stickslip.events.analysis_files import read_analysis_file
 from stickslip.formats.event_table import read_slip_events
 from stickslip.formats.fem_run import read_increments
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 pytestmark = pytest.mark.slow
 

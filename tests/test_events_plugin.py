@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from stickslip import registry
-from stickslip.events import extraction, plugin, results
+from stickslip.events import analysis_files, extraction, plugin
 from stickslip.formats.event_table import read_slip_events
 from stickslip.h5io import FileFormatError
 from stickslip.hashing import sha256_file
@@ -23,7 +23,7 @@ def write(path, events=EVENTS, attrs=RUN_ATTRS):
 
 def test_event_file_round_trip(tmp_path):
     tables = write(tmp_path / "events.h5")
-    read = results.read_analysis_file(tmp_path / "events.h5", "event-table", tuple(tables))
+    read = analysis_files.read_analysis_file(tmp_path / "events.h5", "event-table", tuple(tables))
     assert read.n == 2 and read.regime == "compliant"
     assert read.attrs["N"] == N and read.attrs["seed"] == 4 and read.attrs["steady_state"] == 8
     assert read.attrs["analysis"] == "numerical-events"
@@ -61,7 +61,7 @@ def test_same_input_same_bytes(tmp_path):
 
 def test_run_without_steady_state_gives_empty_slip_tables(tmp_path):
     write(tmp_path / "e.h5", events=[((3, 0), (0.0, 0.0))] * 4)
-    read = results.read_analysis_file(tmp_path / "e.h5", "event-table", ("slips", "sequences", "slip_interfaces"))
+    read = analysis_files.read_analysis_file(tmp_path / "e.h5", "event-table", ("slips", "sequences", "slip_interfaces"))
     assert read.attrs["steady_state"] == -1
     assert all(table.empty for table in read.tables.values())
 
@@ -76,11 +76,11 @@ def test_grouping_by_regime_and_n(tmp_path):
     write(tmp_path / "c.h5")
     write(tmp_path / "s.h5", attrs=run_attrs(N, 3, STIFF, seed=1))
     write(tmp_path / "s2.h5", attrs=run_attrs(N, 3, STIFF, seed=0))
-    files = [results.read_analysis_file(tmp_path / f, "event-table", ("slips",)) for f in ("s.h5", "c.h5", "s2.h5")]
-    groups = results.group_runs(files)
+    files = [analysis_files.read_analysis_file(tmp_path / f, "event-table", ("slips",)) for f in ("s.h5", "c.h5", "s2.h5")]
+    groups = analysis_files.group_runs(files)
     assert list(groups) == [("compliant", 2), ("stiff", 2)]
     assert [f.attrs["seed"] for f in groups[("stiff", 2)]] == [0, 1]
-    assert len(results.pooled(groups[("stiff", 2)], "slips")) == 14
+    assert len(analysis_files.pooled(groups[("stiff", 2)], "slips")) == 14
 
 
 def test_plugin_is_registered():

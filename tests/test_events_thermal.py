@@ -21,7 +21,7 @@ from stickslip.figures.experimental_data import EVENTS
 from stickslip.figures.style import plt
 from stickslip.h5io import open_file, read_table
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 pytestmark = pytest.mark.slow
 

@@ -13,7 +13,7 @@ from stickslip.experiment.aging import fit_aging
 from stickslip.experiment.analysis import ExperimentEventsParams, analyse_record
 from stickslip.experiment.timeseries import read_timeseries, read_truth
 from stickslip.h5io import open_file, read_table
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 T_EXCLUDE = ExperimentEventsParams().t_exclude
 POSITION_NOISE = 0.002  # lever default [mm] per slab

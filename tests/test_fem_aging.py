@@ -36,7 +36,7 @@ from stickslip.fem.thermal.redraws import REDRAW, sample_with_redraws
 from stickslip.fem.thermal.sampler import NONE, THRESHOLD
 from stickslip.formats.fem_run import RunFile, describe, read_increments, read_run_attrs
 from stickslip.h5io import write_attrs
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from stickslip.registry import get, run_id
 from stickslip.solvers.fem import stack_mesh
 
@@ -251,7 +251,7 @@ def test_every_event_renews_the_junctions_of_the_blocks_that_changed_well(aging_
             assert np.array_equal(junctions["junction_well"], np.where(whole, wells[:, 0], -1))
             assert np.all((junctions["junction_depth"] > 0) == whole)
             # the backend holds the window widened by the junctions, each about its well's centre
-            epsy, base = stack.model.epsy, stack.wells.epsy
+            epsy, base = stack.yield_strains, stack.wells.epsy
             for e in np.flatnonzero(whole):
                 j = junctions["junction_well"][e] - stack.wells.offset[e]
                 neighbours = [base[e, j + 2] - base[e, j + 1]] + ([base[e, j] - base[e, j - 1]] if j > 0 else [])

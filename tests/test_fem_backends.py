@@ -13,10 +13,10 @@ from stickslip import registry
 from stickslip.fem.backends import BACKENDS, make_backend
 from stickslip.fem.backends.cpu import StructuredBackend
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.run import run_simulation
+from stickslip.fem.run import simulate_to_file
 from stickslip.fem.simulation import Simulation
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import params_to_dict, parse_params
+from stickslip.plugin_params import params_to_dict, parse_params
 
 
 @pytest.mark.slow
@@ -33,12 +33,12 @@ def test_both_backends_run_the_same_events(relaxation):
         for sim in (reference, other):
             sim.loading.step(False)
             assert sim.protocol.kick(params.margin)[0]
-        wells, u = reference.stack.well_index(), reference.stack.backend.read("u")[0]
+        wells, u = reference.stack.well_index(), reference.backend.read("u")[0]
         np.testing.assert_array_equal(other.stack.well_index(), wells, err_msg=f"event {event}")
         slips += int(np.count_nonzero(wells != before))
         scale = np.abs(u).max()
         tolerance = 1e-10 if relaxation == "exact" else 1e-6  # exact: solved equilibria; dynamic: tol 1e-5
-        other_u = other.stack.backend.read("u")[0]
+        other_u = other.backend.read("u")[0]
         assert np.abs(other_u - u).max() < tolerance * scale, f"event {event}"
         assert other_u.tobytes() != u.tobytes() or event == 0  # other round-off, indeed
     assert slips > 12  # the events moved wells
@@ -52,7 +52,7 @@ def test_the_backend_is_a_parameter_that_makes_its_own_run_id_and_the_default_le
     assert registry.run_id(plugin, assembled) != registry.run_id(plugin, default)
     assert set(BACKENDS) == {"structured", "assembled", "cuda"}
     with pytest.raises(ValueError, match="backend 'assembled' given for a run whose parameter 'backend' is"):
-        run_simulation(default, "unused.h5", build_stack_mesh(MeshParams(N=9)), make_backend("assembled"),
+        simulate_to_file(default, "unused.h5", build_stack_mesh(MeshParams(N=9)), make_backend("assembled"),
                        producer=("fem", "x"))
 
 

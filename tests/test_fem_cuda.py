@@ -13,7 +13,6 @@ where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set, as .ci/run does); the checks that
 benchmarks/gpu/ (docs/benchmarks.md).
 """
 
-import importlib.util
 import json
 import os
 import subprocess
@@ -23,16 +22,6 @@ import textwrap
 import pytest
 
 pytestmark = pytest.mark.slow
-
-
-@pytest.fixture(scope="module")
-def numba_cuda():
-    """numba-cuda is installed (skip, or fail where .ci/run requires it)."""
-    if importlib.util.find_spec("numba_cuda") is None:
-        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
-        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
-            pytest.fail(reason)
-        pytest.skip(reason)
 
 
 def _run(script, timeout=1800, simulator=True):
@@ -64,9 +53,9 @@ PRELUDE = """
         return cpu, gpu
 
     def compare(cpu, gpu):
-        out = {"idx": bool(np.array_equal(cpu.stack.backend.read("idx")[0], gpu.stack.backend.read("idx")[0]))}
+        out = {"idx": bool(np.array_equal(cpu.backend.read("idx")[0], gpu.backend.read("idx")[0]))}
         for name in FIELDS:
-            a, b = cpu.stack.backend.read(name)[0], gpu.stack.backend.read(name)[0]
+            a, b = cpu.backend.read(name)[0], gpu.backend.read(name)[0]
             scale = float(np.abs(a).max())
             out[name] = float(np.abs(a - b).max()) / scale if scale else float(np.abs(b).max())
         return out
@@ -90,12 +79,12 @@ def test_every_kernel_compiles_for_sm_90_with_one_grid_barrier_per_step_and_no_f
     result = _run("""
     from stickslip.fem.backends.cuda.compile import KERNELS, ptx, ptx_figures
     from stickslip.fem.constants import derived_constants
-    from stickslip.fem.stack import build_stack
+    from stickslip.fem.stack import stack_model
     out = {}
     for law, kernels in (("cusp", KERNELS), ("smooth", ("minimise", "evaluate"))):
         params = FemParams(N=9, plates=2, nchunk=30, interface_law=law)
         mesh = build_stack_mesh(MeshParams(N=9, plates=2))
-        model = build_stack(params, mesh, make_backend(), derived_constants(params, mesh)).model
+        model, _ = stack_model(params, mesh, derived_constants(params, mesh))
         for name, text in ptx(model, mesh, kernels=kernels).items():
             out[f"{law}:{name}"] = ptx_figures(text)
     print(json.dumps(out))
@@ -125,9 +114,9 @@ def simulated(numba_cuda):
             sim.loading.step(True)
         out[f"{drive}:kick"] = compare(cpu, gpu)
         for sim in (cpu, gpu):
-            sim.stack.backend.advance(3)
+            sim.backend.advance(3)
         out[f"{drive}:steps"] = compare(cpu, gpu)
-        out[f"{drive}:residual"] = abs(cpu.stack.backend.residual() / gpu.stack.backend.residual() - 1)
+        out[f"{drive}:residual"] = abs(cpu.backend.residual() / gpu.backend.residual() - 1)
     # the step limit, with the well changes of Gauss point 0 recorded: block 4 sheared ~10 wells ahead (it and
     # its neighbours change wells in the first steps)
     cpu, gpu = pair()
@@ -135,28 +124,28 @@ def simulated(numba_cuda):
     for sim in (cpu, gpu):
         sim.loading.step(False)
         sim.loading.step(True)
-        sim.stack.backend.add_u(sim.stack.model.iface_dofs[4], 6e-3 * mode)
-    runs = [sim.stack.backend.minimise(1e-5, 20, 6, 0, True, 0) for sim in (cpu, gpu)]
+        sim.backend.add_u(sim.model.iface_dofs[4], 6e-3 * mode)
+    runs = [sim.backend.minimise(1e-5, 20, 6, 0, True, 0) for sim in (cpu, gpu)]
     out["limit"] = [runs[0][:2], runs[1][:2], bool(np.array_equal(runs[0][2], runs[1][2])), len(runs[0][2]),
                     compare(cpu, gpu)]
     # the quiet window: from a state at rest after a load step no well changes
     cpu, gpu = pair()
     for sim in (cpu, gpu):
         sim.loading.step(False)
-    runs = [sim.stack.backend.minimise(1e-5, 50, 100, 0, False, 3)[:2] for sim in (cpu, gpu)]
+    runs = [sim.backend.minimise(1e-5, 50, 100, 0, False, 3)[:2] for sim in (cpu, gpu)]
     out["quiet"] = [runs[0], runs[1], compare(cpu, gpu)]
     # the residual criterion, after the exact relaxation's direct solve (its Newton iterations on the device)
     cpu, gpu = pair(relaxation="exact")
-    solved = [sim.relaxation.solve_in_wells(sim.stack.backend) for sim in (cpu, gpu)]
-    runs = [sim.stack.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2] for sim in (cpu, gpu)]
-    out["converged"] = [solved, runs[0], runs[1], compare(cpu, gpu), float(np.abs(gpu.stack.backend.read("v")[0]).max())]
+    solved = [sim.relaxation.solve_in_wells(sim.backend) for sim in (cpu, gpu)]
+    runs = [sim.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2] for sim in (cpu, gpu)]
+    out["converged"] = [solved, runs[0], runs[1], compare(cpu, gpu), float(np.abs(gpu.backend.read("v")[0]).max())]
     # the margin: a kicked point in well 1 with a margin that allows none beyond well 0
     cpu, gpu = pair()
     for sim in (cpu, gpu):
         sim.loading.step(False)
         sim.loading.step(True)
-    ny = cpu.stack.model.epsy.shape[1]
-    out["margin"] = [sim.stack.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
+    ny = cpu.model.epsy.shape[1]
+    out["margin"] = [sim.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
     # a thermal load increment (kinetic Monte Carlo on the host, the hop's relaxation on the device)
     cpu, gpu = pair(relaxation="exact", quiet_steps=3, temperature=2e-3, drive_rate=1e-5)
     out["thermal"] = [[sim.protocol.step(False, 5, 1)] for sim in (cpu, gpu)]
@@ -171,8 +160,8 @@ def simulated(numba_cuda):
                          backend)  # exact: the linear response by one solve (the simulator is slow)
         sim.loading.step(False)
         sim.loading.step(True)
-        status = sim.stack.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
-        return [status] + [sim.stack.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx")]
+        status = sim.backend.minimise(1e-5, 20, steps[seed], 0, False, 0)[:2]
+        return [status] + [sim.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx")]
 
     from stickslip.fem.backends.cuda import launch
     launch.STEPS_PER_LAUNCH = 2  # several launches per minimisation
@@ -223,7 +212,7 @@ def test_a_thermal_run_with_junction_aging_draws_and_relaxes_the_same_hop_after_
     # increment: the event increment's renewals relax for minutes on the simulator (their minimisations are those
     # of the checks above)
     result = _run(f"""
-    from stickslip.fem.run import run_simulation
+    from stickslip.fem.run import simulate_to_file
     from stickslip.formats.fem_run import RunFile, read_increments
     from stickslip.h5io import open_file
 
@@ -233,7 +222,7 @@ def test_a_thermal_run_with_junction_aging_draws_and_relaxes_the_same_hop_after_
     out = {{}}
     for backend in ("structured", "cuda"):
         path = {str(tmp_path)!r} + "/" + backend + ".h5"
-        run_simulation(FemParams(**values, backend=backend), path, mesh, make_backend(backend), producer=("fem", "test"))
+        simulate_to_file(FemParams(**values, backend=backend), path, mesh, make_backend(backend), producer=("fem", "test"))
         table = read_increments(path)
         with open_file(path, "r") as file:
             run = RunFile(file)
@@ -340,11 +329,11 @@ def test_an_ensemble_computes_a_linear_response_in_a_batch_of_the_elastic_law(nu
     from stickslip.fem.backends.cuda.ensemble import Ensemble
     from stickslip.fem.constants import derived_constants
     from stickslip.fem.laws import Elastic
-    from stickslip.fem.stack import build_stack
+    from stickslip.fem.stack import stack_model
 
     params = FemParams(N=9, plates=2, nchunk=30)
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
-    model = build_stack(params, mesh, make_backend(), derived_constants(params, mesh)).model
+    model, _ = stack_model(params, mesh, derived_constants(params, mesh))
     elastic = model._replace(law=Elastic(*model.law), epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
     ensemble = Ensemble(1)
     cusp_batch, elastic_batch = ensemble.batch_for(model, mesh), ensemble.batch_for(elastic, mesh)

@@ -14,7 +14,6 @@ Python with a time limit, so a hang fails it. The checks, each against the same 
   the barrier's deadline ends the launch with an error, not a hang.
 """
 
-import importlib.util
 import json
 import os
 import subprocess
@@ -23,19 +22,10 @@ import textwrap
 
 import pytest
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.usefixtures("numba_cuda")]
 
 #: Seconds a check may take (a hang fails it).
 TIMEOUT = int(os.environ.get("STICKSLIP_CUDA_SIM_TIMEOUT", "900"))
-
-
-@pytest.fixture(scope="module", autouse=True)
-def numba_cuda():
-    if importlib.util.find_spec("numba_cuda") is None:
-        reason = "numba-cuda is not installed (pip install -e '.[gpu]' in a clone)"
-        if os.environ.get("STICKSLIP_REQUIRE_CUDA_TOOLS"):
-            pytest.fail(reason)
-        pytest.skip(reason)
 
 
 PRELUDE = """
@@ -60,14 +50,14 @@ PRELUDE = """
         sim = Simulation(params, MESH, backend, response=RESPONSE)
         sim.loading.step(False)
         sim.loading.step(True)
-        sim.stack.backend.add_u(sim.stack.model.iface_dofs[4], amplitude * shear_modes(MESH)[4])
+        sim.backend.add_u(sim.model.iface_dofs[4], amplitude * shear_modes(MESH)[4])
         return sim
 
     def state(sim):
-        return [sim.stack.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx", "t")]
+        return [sim.backend.read(name)[0].tobytes().hex() for name in ("u", "v", "a", "f", "idx", "t")]
 
     def groups(sim):
-        return {int(g): n for g, n in sim.stack.backend.batch.launcher.groups_used.items()}
+        return {int(g): n for g, n in sim.backend.batch.launcher.groups_used.items()}
 """
 
 
@@ -86,12 +76,12 @@ def _run(script):
 def test_a_realisation_spread_over_three_blocks_gives_the_bytes_of_one_block():
     result = _run("""
     cpu = kicked(make_backend())
-    expected = cpu.stack.backend.minimise(1e-5, 20, 6, 0, True, 0)
+    expected = cpu.backend.minimise(1e-5, 20, 6, 0, True, 0)
     out = {"cpu": [list(expected[:2]), expected[2].tolist()]}
     for G in (1, 3):
         with concurrent_blocks(6):
             sim = kicked(CudaBackend(groups=G))
-            status, steps, events = sim.stack.backend.minimise(1e-5, 20, 6, 0, True, 0)
+            status, steps, events = sim.backend.minimise(1e-5, 20, 6, 0, True, 0)
         out[G] = [[status, steps], events.tolist(), state(sim), groups(sim)]
     print(json.dumps(out))
     """)
@@ -110,13 +100,13 @@ def test_blocks_per_realisation_change_between_launches_while_runs_leave():
     def converging(seed, backend):
         params = FemParams(**VALUES, seed=seed, relaxation="exact", backend=backend.name)
         sim = Simulation(params, MESH, backend, response=RESPONSE)
-        solved = sim.relaxation.solve_in_wells(sim.stack.backend)  # its Newton iterations on the device
-        status = sim.stack.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2]
+        solved = sim.relaxation.solve_in_wells(sim.backend)  # its Newton iterations on the device
+        status = sim.backend.minimise(1e-5, 3, 100, 0, False, 0)[:2]
         return [solved, list(status), state(sim), groups(sim)]
 
     def ending(backend):
         sim = kicked(backend, 3, 6e-3)
-        return [True, list(sim.stack.backend.minimise(1e-5, 20, 2, 0, False, 0)[:2]), state(sim), groups(sim)]
+        return [True, list(sim.backend.minimise(1e-5, 20, 2, 0, False, 0)[:2]), state(sim), groups(sim)]
 
     runs = [lambda backend: converging(1, backend), lambda backend: converging(2, backend), ending]
     with concurrent_blocks(6):
@@ -135,12 +125,12 @@ def test_an_event_buffer_that_a_step_overflows_is_emptied_and_grown_not_dropped(
     result = _run("""
     batch_module.EVENT_CAPACITY = 2  # a step of this minimisation changes 5 wells
     cpu = kicked(make_backend())
-    expected = cpu.stack.backend.minimise(1e-5, 20, 6, 0, True, 0)
+    expected = cpu.backend.minimise(1e-5, 20, 6, 0, True, 0)
     with concurrent_blocks(6):
         sim = kicked(CudaBackend(groups=3))
-        got = sim.stack.backend.minimise(1e-5, 20, 6, 0, True, 0)
+        got = sim.backend.minimise(1e-5, 20, 6, 0, True, 0)
     print(json.dumps({"cpu": [list(expected[:2]), expected[2].tolist()], "gpu": [list(got[:2]), got[2].tolist()],
-                      "groups": groups(sim), "rows": sim.stack.backend.batch.state.control["events"].shape[1]}))
+                      "groups": groups(sim), "rows": sim.backend.batch.state.control["events"].shape[1]}))
     """)
     assert result["gpu"] == result["cpu"] and len(result["cpu"][1]) == 10
     assert result["groups"]["3"] > 1  # relaunched after the buffer filled
@@ -156,7 +146,7 @@ def test_blocks_that_never_meet_raise_an_error_instead_of_hanging():
         sim = kicked(CudaBackend(groups=2))
         start = time.perf_counter()
         try:
-            sim.stack.backend.advance(3)
+            sim.backend.advance(3)
             error = None
         except launch_module.BarrierTimeout as caught:
             error = str(caught)

@@ -57,13 +57,13 @@ def sim():
 def _drive_at_rest(sim, u):
     """Set displacement ``u`` with the drive springs at rest (targets at the layer averages)."""
     sim.stack.restore(u, np.zeros(sim.mesh.nlayer), 0.0, 0.0)
-    sim.stack.restore(u, sim.stack.backend.read("ubar")[0].copy(), 0.0, 0.0)
-    return sim.stack.backend.read("f")[0]
+    sim.stack.restore(u, sim.backend.read("ubar")[0].copy(), 0.0, 0.0)
+    return sim.backend.read("f")[0]
 
 
 def test_homogeneous_simple_shear_gives_the_shear_modulus(sim):
     gamma = 1e-6
-    mesh, model = sim.mesh, sim.stack.model
+    mesh, model = sim.mesh, sim.model
     y = mesh.coor[:, 1]
     u = np.zeros(model.ndof)
     u[mesh.dofs[:, 0]] = 2.0 * gamma * y
@@ -87,18 +87,18 @@ def test_homogeneous_simple_shear_gives_the_shear_modulus(sim):
 
 def test_uniaxial_strain_gives_bulk_and_shear_energy(sim):
     eps = 1e-6
-    u = np.zeros(sim.stack.model.ndof)
+    u = np.zeros(sim.model.ndof)
     u[sim.mesh.dofs[:, 1]] = eps * sim.mesh.coor[:, 1]
     f = _drive_at_rest(sim, u)
     # eps_m = eps / 2, eps_eq = eps / 2: U = (K + G) eps^2 / 4
-    expected = (sim.params.K + sim.params.G) * eps**2 / 4 * sim.stack.model.layer_volume.sum()
+    expected = (sim.params.K + sim.params.G) * eps**2 / 4 * sim.model.layer_volume.sum()
     assert 0.5 * u @ f == pytest.approx(expected, rel=1e-10)
 
 
 def _undamped_energy_error(sim, dt, nsteps):
-    model = sim.stack.model._replace(damping=np.zeros(sim.stack.model.ndof), dt=dt,
-                                     drive_active=np.zeros_like(sim.stack.model.drive_active))
-    backend = sim.stack.backend.for_model(model)
+    model = sim.model._replace(damping=np.zeros(sim.model.ndof), dt=dt,
+                                     drive_active=np.zeros_like(sim.model.drive_active))
+    backend = sim.backend.for_model(model)
     x, y = sim.mesh.coor[:, 0], sim.mesh.coor[:, 1]
     L, H = sim.mesh.N * sim.mesh.h, y.max()
     u = np.zeros(model.ndof)
@@ -115,7 +115,7 @@ def _undamped_energy_error(sim, dt, nsteps):
 
 
 def test_undamped_dynamics_conserves_energy_to_second_order(sim):
-    dt = sim.stack.model.dt
+    dt = sim.model.dt
     coarse = _undamped_energy_error(sim, dt, 1000)
     fine = _undamped_energy_error(sim, dt / 2, 2000)
     assert coarse < 1e-3
@@ -170,9 +170,9 @@ def test_shear_pulse_travels_at_the_shear_wave_speed():
 
 
 def test_linear_response_and_load_step_superpose(sim):
-    stack, model, nlayer = sim.stack, sim.stack.model, sim.mesh.nlayer
-    backend = stack.backend
-    r = compute_linear_response(stack, sim.relaxation, sim.params, sim.mesh)
+    stack, model, nlayer = sim.stack, sim.model, sim.mesh.nlayer
+    backend = sim.backend
+    r = compute_linear_response(stack, model, sim.relaxation, sim.params, sim.mesh)
     # the response is linear: forces scale with the displacement (interfaces in their first well)
     stack.restore(3.0 * r.delta_u, 3.0 * r.delta_target, 0.0, 0.0)
     f3 = backend.read("f")[0].copy()
@@ -208,7 +208,7 @@ def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells
     # vectorised kernel, with displacements large enough that many points change well (the
     # recompute path)
     backend = Simulation(FemParams(N=9, plates=3, nchunk=50, interface_law=law),
-                         build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).stack.backend
+                         build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).backend
     model, state = backend.model, new_state(backend.model)
     assert model.law.name == law
     rng = np.random.default_rng(3)

@@ -127,7 +127,7 @@ def _smooth_simulation(relaxation, **values):
 @pytest.mark.slow
 def test_the_event_driven_protocol_and_both_relaxations_run_with_the_smooth_law():
     dynamic, exact = _smooth_simulation("dynamic", tol=1e-9), _smooth_simulation("exact")
-    assert dynamic.stack.model.law == Smooth(4.5, 1.0)
+    assert dynamic.model.law == Smooth(4.5, 1.0)
     for event in range(8):
         wells = []
         for sim in (dynamic, exact):
@@ -141,11 +141,11 @@ def test_the_event_driven_protocol_and_both_relaxations_run_with_the_smooth_law(
         np.testing.assert_array_equal(wells[0], wells[1], err_msg=f"event {event}")
         # the exact relaxation ends at rest in the current wells, with a residual below tol (tol^2, or tol
         # where the iterations stall, as for the cusp)
-        backend = exact.stack.backend
+        backend = exact.backend
         assert backend.residual() < exact.params.tol
         assert backend.wells_hold()
         u, v = backend.read("u", "v")
         assert v.max() == v.min() == 0.0
         scale = np.abs(u).max()
-        assert np.abs(dynamic.stack.backend.read("u")[0] - u).max() < 1e-3 * scale
+        assert np.abs(dynamic.backend.read("u")[0] - u).max() < 1e-3 * scale
         dynamic.stack.restore(*exact.stack.stored())  # continue both from the same state

@@ -6,7 +6,7 @@ import pytest
 from stickslip import registry
 from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 pytestmark = pytest.mark.slow
 

@@ -14,7 +14,7 @@ import pytest
 
 from stickslip.cli import main
 from stickslip.fem.parameters import REACH_REGIME, FemParams, thermal_reach
-from stickslip.params import ParameterError, ParameterWarning, parse_params
+from stickslip.plugin_params import ParameterError, ParameterWarning, parse_params
 
 THERMAL = {"temperature": "1e-3", "drive_rate": "2e-8", "yield_strains": "extend"}
 

@@ -21,7 +21,7 @@ from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.h5io import FileFormatError
 from stickslip.mesh import MeshParams, build_stack_mesh
 from stickslip.numba_options import set_num_threads
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "FixedLever_historic.h5"
 
@@ -157,8 +157,8 @@ def test_results_do_not_depend_on_the_number_of_threads():
         sim = Simulation(params, mesh, make_backend(params.backend, threads))
         sim.loading.step(kick=False)
         sim.loading.step(kick=True)
-        sim.stack.backend.advance(300)  # blocks yield during these steps
-        states.append(sim.stack.backend.read("u", "v", "a", "f", "idx", "sig"))
+        sim.backend.advance(300)  # blocks yield during these steps
+        states.append(sim.backend.read("u", "v", "a", "f", "idx", "sig"))
     set_num_threads(1)
     for name, one, two in zip(("u", "v", "a", "f", "idx", "sig"), *states):
         np.testing.assert_array_equal(one, two, err_msg=name)

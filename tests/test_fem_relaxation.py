@@ -16,7 +16,7 @@ from stickslip.fem.protocol import AthermalProtocol
 from stickslip.fem.simulation import Simulation
 from stickslip.formats.fem_run import read_increments, read_run_attrs
 from stickslip.mesh import MeshParams, build_stack_mesh
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 CASE = {"N": 9, "plates": 2, "seed": 0, "k_drive": 1e-3, "drive": "fixed-lever", "nchunk": 200}
 
@@ -31,9 +31,9 @@ def test_direct_linear_response_is_an_equilibrium_and_the_limit_of_the_dynamic_o
     exact = _simulation(N=18, plates=3, drive=drive, relaxation="exact")
     response = exact.loading.response
     # equilibrium of the full nonlinear force (all wells elastic at this small strain): f = 0 on free DOFs
-    exact.stack.backend.set_state(response.delta_u, response.delta_target, response.delta_lever, 0.0)
-    f, eps = exact.stack.backend.read("f", "eps")
-    free = ~exact.stack.model.prescribed
+    exact.backend.set_state(response.delta_u, response.delta_target, response.delta_lever, 0.0)
+    f, eps = exact.backend.read("f", "eps")
+    free = ~exact.model.prescribed
     assert np.abs(f[free]).max() < 1e-12 * np.abs(f[~free]).max()
     np.testing.assert_allclose(eps, response.delta_eps, rtol=0, atol=1e-12 * np.abs(response.delta_eps).max())
     # the paper's dynamic minimisation converges to it (its residual tolerance 1e-5 leaves ~1e-5 relative)
@@ -45,7 +45,7 @@ def test_direct_linear_response_is_an_equilibrium_and_the_limit_of_the_dynamic_o
 
 def test_equilibrium_in_wells_is_where_the_dynamics_end():
     sim = _simulation(relaxation="dynamic", tol=1e-9)
-    backend = sim.stack.backend
+    backend = sim.backend
     sim.loading.step(False)
     sim.loading.step(True)
     sim.relaxation.relax(backend)  # to residual 1e-9: far tighter than the protocol's 1e-5
@@ -59,7 +59,7 @@ def test_equilibrium_in_wells_is_where_the_dynamics_end():
 
 def test_an_equilibrium_outside_the_current_wells_is_rejected_and_leaves_the_state_as_it_was():
     sim = _simulation(relaxation="exact")
-    backend = sim.stack.backend
+    backend = sim.backend
     sim.loading.step(False)
     before = sim.stack.stored()
     backend.state.idx[0, :] += 3  # three wells up (the CPU state, changed behind the backend's back on purpose)
@@ -77,12 +77,12 @@ def test_exact_relaxation_quenches_a_kick_in_far_fewer_steps():
     steps = {}
     for relaxation in ("dynamic", "exact"):
         sim = _simulation(relaxation=relaxation)
-        backend = sim.stack.backend
+        backend = sim.backend
         sim.loading.step(False)
         wells = backend.read("idx")[0].copy()
         t0 = sim.stack.time
         assert sim.protocol.kick(5) == (True, False)
-        steps[relaxation] = (sim.stack.time - t0) / sim.stack.model.dt
+        steps[relaxation] = (sim.stack.time - t0) / sim.model.dt
         changed = backend.read("idx")[0] != wells
         assert changed.any()
         if relaxation == "exact":
@@ -95,12 +95,12 @@ def test_exact_relaxation_quenches_a_kick_in_far_fewer_steps():
 def test_the_linear_response_leaves_the_stack_as_it_was():
     sim = _simulation(relaxation="exact")
     sim.loading.step(False)
-    before = sim.stack.backend.checkpoint()
-    again = compute_linear_response(sim.stack, sim.relaxation, sim.params, sim.mesh)
+    before = sim.backend.checkpoint()
+    again = compute_linear_response(sim.stack, sim.model, sim.relaxation, sim.params, sim.mesh)
     for mine, theirs in zip(again, sim.loading.response):
         assert np.asarray(mine).tobytes() == np.asarray(theirs).tobytes()
     for name, value in zip(before._fields, before):
-        assert sim.stack.backend.read(name)[0].tobytes() == value.tobytes(), name
+        assert sim.backend.read(name)[0].tobytes() == value.tobytes(), name
 
 
 @pytest.mark.parametrize("N, dt_scale, steps", [(9, 1.0, 267), (162, 1.0, 4799), (162, 2.0, 2400), (1458, 1.0, 43185)])

@@ -62,17 +62,17 @@ PRELUDE = """
     from stickslip.fem.parameters import FemParams
     from stickslip.fem.simulation import Simulation
     from stickslip.mesh import MeshParams, build_stack_mesh
-    from stickslip.params import ParameterError, parse_params
+    from stickslip.plugin_params import ParameterError, parse_params
 
     def events(sim, count):
         rows = []
-        transfers = sim.stack.backend.transfers
+        transfers = sim.backend.transfers
         for _ in range(count):
             sim.loading.step(False)
             before, t0 = dict(transfers), sim.stack.time
             assert sim.protocol.kick(5)[0]
             moved = {name: transfers[name] - before.get(name, 0) for name in transfers}
-            rows.append((round((sim.stack.time - t0) / sim.stack.model.dt), moved))
+            rows.append((round((sim.stack.time - t0) / sim.model.dt), moved))
         return rows
 """
 
@@ -90,7 +90,7 @@ def _states(law, values):
     for _ in range(10):
         sim.loading.step(False)
         sim.protocol.kick(5)
-        states.append(sim.stack.backend.read("u")[0].tobytes().hex())
+        states.append(sim.backend.read("u")[0].tobytes().hex())
     """
 
 
@@ -111,7 +111,7 @@ def test_a_law_is_one_module_the_soft_cusp_at_c_one_is_the_cusp_bit_for_bit(tmp_
             errors.append(str(error))
     soft = Simulation(FemParams(N=9, plates=2, interface_law="soft-cusp", law_params=(0.5,)), mesh, make_backend(),
                       response=response)
-    print(json.dumps({"states": states, "errors": errors, "law": repr(soft.stack.model.law)}))
+    print(json.dumps({"states": states, "errors": errors, "law": repr(soft.model.law)}))
     """, own_cache=True)
     assert result["states"] == namespace["states"]
     assert result["law"] == "SoftCusp(K=4.5, G=1.0, c=0.5)"
@@ -130,7 +130,7 @@ def test_the_backend_owns_the_state_transfers_per_event_do_not_grow_with_the_tim
     hot = FemParams(N=9, plates=2, seed=1, k_drive=1e-3, relaxation="exact", dt_scale=4.0, temperature=2e-3,
                     drive_rate=1e-5, backend="counting")
     sim = Simulation(hot, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend("counting"))
-    transfers = sim.stack.backend.transfers
+    transfers = sim.backend.transfers
     thermal = []
     for increment in range(1, 21):
         before = dict(transfers)

@@ -8,7 +8,7 @@ from stickslip import registry
 from stickslip.fem.stiffness import PHI_STIFF, at_paper_phi, driving_regime, stiffness_ratio
 from stickslip.formats.fem_run import describe, read_run_attrs
 from stickslip.mesh.rows import plate_target_height
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 
 def test_phi_of_the_paper_runs_is_the_paper_number():

@@ -10,14 +10,15 @@ from stickslip.fem.backends.cpu.stencils import balanced_blocks, build_stencils,
 from stickslip.fem.constants import derived_constants
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.quad4 import element_coordinates, shape_gradients
-from stickslip.fem.stack import build_stack
+from stickslip.fem.stack import stack_model
 from stickslip.mesh import MeshParams, build_stack_mesh
 
 
 def _backend(mesh, name, threads=1):
     """A CPU backend ``name`` prepared for the stack of ``mesh``."""
     params = FemParams(N=mesh.N, plates=mesh.plates, nchunk=20)
-    return build_stack(params, mesh, make_backend(name, threads), derived_constants(params, mesh)).backend
+    model, _ = stack_model(params, mesh, derived_constants(params, mesh))
+    return make_backend(name, threads).prepare(model, mesh)
 
 
 @pytest.mark.parametrize("plates_", [2, 3, 4, 5, 6])

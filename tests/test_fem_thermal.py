@@ -28,7 +28,7 @@ from stickslip.formats.fem_run import RunFile, read_increments, read_run_attrs
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.thermal import (BACKWARD, FORWARD, HOP, NONE, THRESHOLD, barrier_bounds, block_barrier,
                                    hop_step, sample_event)
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.registry import get
 
 H = math.pi  # block size

@@ -8,7 +8,7 @@ from stickslip import registry
 from stickslip.fem.yield_strains import HeldYieldStrains, interface_initstate, narrowest_well, yield_strains
 from stickslip.formats.fem_run import read_run_attrs
 from stickslip.h5io import read_table
-from stickslip.params import describe, parse_params
+from stickslip.plugin_params import describe, parse_params
 
 
 def test_slid_and_widened_windows_hold_the_values_of_the_long_sequence():

@@ -16,7 +16,7 @@ from stickslip.figures.experimental_panels import single_slips
 from stickslip.figures.style import plt
 from stickslip.h5io import FileFormatError
 from stickslip.lineage import Artifact
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "figS-individual", "figS-slip-distributions", "figS-aging-variations",
            "figS-slow-slip")

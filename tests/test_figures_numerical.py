@@ -13,10 +13,10 @@ from matplotlib.text import Text
 from stickslip import registry
 from stickslip.events import fronts, plugin
 from stickslip.events.extraction import slip_fractions
-from stickslip.events.results import group_runs, pooled, read_analysis_file
+from stickslip.events.analysis_files import group_runs, pooled, read_analysis_file
 from stickslip.figures import figs_sequences
 from stickslip.h5io import FileFormatError
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from test_events_extraction import history, run_attrs
 from test_fronts import C_S, H_BLOCK, SPACING, rupture
 

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from stickslip.events import extraction, fronts
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from test_events_extraction import EVENTS, history
 
 H_BLOCK = np.pi  # block size l0 [FE length]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from stickslip.experiment.virtual import first_crossing, integrate, relative_positions
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.experiment.virtual.model import apparatus, friction_law, simulate
 from stickslip.solvers.lever import LeverParams
 

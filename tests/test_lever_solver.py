@@ -11,7 +11,7 @@ import pytest
 from stickslip import registry
 from stickslip.cli import main
 from stickslip.experiment.timeseries import read_timeseries, read_truth
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from stickslip.experiment.virtual.model import simulate
 from stickslip.solvers.lever import LeverParams
 

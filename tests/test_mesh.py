@@ -12,7 +12,7 @@ from stickslip.h5io import FileFormatError
 from stickslip.mesh import (MeshParams, build_stack_mesh, load_mesh, mesh_id, read_mesh, save_mesh,
                             write_mesh)
 from stickslip.mesh.rows import FINE_ABOVE, fine_layer_half, plate_target_height
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ import pytest
 from stickslip import registry
 from stickslip.h5io import FileFormatError
 from stickslip.mesh import MeshParams, read_mesh, write_mesh
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 
 @pytest.fixture(scope="module")

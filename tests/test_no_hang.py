@@ -28,7 +28,7 @@ from stickslip.fem.thermal.junctions import expected_redraws, renew, widen
 from stickslip.fem.thermal.redraws import PAUSED, redraw_loop, sample_with_redraws
 from stickslip.fem.thermal.sampler import HOP, NONE, STALLED, THRESHOLD, draw_event, sample_event
 from stickslip.formats.fem_run import read_run_attrs
-from stickslip.params import ParameterError, ParameterWarning, parse_params
+from stickslip.plugin_params import ParameterError, ParameterWarning, parse_params
 
 AGING = {"N": "9", "plates": "2", "temperature": "1e-3", "drive_rate": "2e-8", "junction_strengthening": "5"}
 

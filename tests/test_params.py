@@ -4,7 +4,7 @@ import dataclasses
 
 import pytest
 
-from stickslip.params import (ParameterError, describe, json_schema, param, params_to_dict, parse_assignments,
+from stickslip.plugin_params import (ParameterError, describe, json_schema, param, params_to_dict, parse_assignments,
                               parse_params)
 
 

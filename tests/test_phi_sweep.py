@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from stickslip.events.phi_sweep import crossover, sweep_table, wilson_interval
-from stickslip.events.results import AnalysisFile
+from stickslip.events.analysis_files import AnalysisFile
 
 
 def test_wilson_interval_brackets_the_fraction_and_shrinks_as_one_over_root_m():

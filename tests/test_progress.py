@@ -16,7 +16,7 @@ import pytest
 from stickslip import progress, registry
 from stickslip.events.extraction import classify_increments
 from stickslip.formats.fem_run import read_increments
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 from conftest import python_path
 

@@ -15,8 +15,8 @@ from stickslip.provenance.record import (REQUIRED_FIELDS, read_record, record_pa
 
 def test_code_hash_follows_package_imports():
     sources = {p.relative_to(code.ROOT).as_posix() for p in code.module_sources("stickslip.cli.simulate")}
-    # direct (registry), through another package module (registry -> params), and the package inits
-    assert {"cli/simulate.py", "registry.py", "params.py", "numba_options.py", "__init__.py",
+    # direct (registry), through another package module (registry -> plugin_params), and the package inits
+    assert {"cli/simulate.py", "registry.py", "plugin_params.py", "numba_options.py", "__init__.py",
             "cli/__init__.py"} <= sources
     assert "figures/style.py" not in sources
     assert len(code.code_hash("stickslip.h5io")) == 16
@@ -26,7 +26,7 @@ def test_the_public_api_is_in_no_plugins_code_hash(tmp_path, monkeypatch):
     # stickslip/__init__.py binds the API (stickslip.api, runs, results, ...): its imports are not the plugins'
     sources = {p.relative_to(code.ROOT).as_posix() for p in code.module_sources("stickslip.solvers.fem")}
     assert "__init__.py" in sources and "fem/run.py" in sources
-    assert not {"api.py", "runs.py", "results.py", "events/extraction.py", "provenance/query.py"} & sources
+    assert not {"api.py", "runs.py", "study_results.py", "events/extraction.py", "provenance/query.py"} & sources
     package = tmp_path / "stickslip"
     shutil.copytree(code.ROOT, package, ignore=shutil.ignore_patterns("__pycache__"))
     monkeypatch.setattr(code, "ROOT", package)
@@ -49,7 +49,7 @@ def test_code_hash_changes_with_the_sources(tmp_path, monkeypatch):
     try:
         before = code.code_hash("stickslip.cli.simulate")
         unrelated = code.code_hash("stickslip.figures.style")
-        params = package / "params.py"
+        params = package / "plugin_params.py"
         params.write_text(params.read_text() + "\n# edited\n")
         assert code.code_hash("stickslip.cli.simulate") != before  # imported through registry
         assert code.code_hash("stickslip.figures.style") == unrelated

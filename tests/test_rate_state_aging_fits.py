@@ -17,7 +17,7 @@ from stickslip import registry
 from stickslip.experiment.aging import fit_aging, fit_aging_per_interface
 from stickslip.experiment.analysis import analyse_record
 from stickslip.experiment.timeseries import read_timeseries, read_truth
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 
 TRANSIENT = 300.0  # s, the analysis' default t_exclude
 

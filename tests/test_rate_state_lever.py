@@ -19,7 +19,7 @@ from stickslip.experiment.virtual import rosenbrock, slab_dynamics
 from stickslip.experiment.virtual.slab_dynamics import SlabDynamics
 from stickslip.experiment.virtual.slab_equations import rhs
 from stickslip.experiment.virtual.slab_linear_system import factorize, new_factors, solve
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from stickslip.experiment.virtual import rate_state_model
 
 N, H, h = 49.0, 100.0, 10.0

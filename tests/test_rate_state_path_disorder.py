@@ -14,7 +14,7 @@ from stickslip.experiment.virtual import Apparatus
 from stickslip.experiment.virtual.rate_state import RateStateLaw
 from stickslip.experiment.virtual.slab_dynamics import SlabDynamics
 from stickslip.experiment.virtual.slip_path import PathProfiles, level, path_stream, random_profiles
-from stickslip.params import parse_params
+from stickslip.plugin_params import parse_params
 from stickslip.experiment.virtual import rate_state_model
 
 N, H, h = 49.0, 100.0, 10.0

@@ -7,7 +7,7 @@ import sys
 import pytest
 
 from stickslip import registry
-from stickslip.params import param, parse_params
+from stickslip.plugin_params import param, parse_params
 
 
 @dataclasses.dataclass(frozen=True)

@@ -20,7 +20,7 @@ from stickslip.arithmetic import ArithmeticMismatchError
 from stickslip.fem.backends import backend_arithmetic
 from stickslip.formats.fem_run import check_arithmetic
 from stickslip.h5io import FileFormatError
-from stickslip.params import ParameterError
+from stickslip.plugin_params import ParameterError
 
 AGING = {"N": 9, "plates": 2, "temperature": 1e-3, "drive_rate": 2e-8, "junction_strengthening": 5.0}
 

@@ -24,7 +24,7 @@ import yaml
 
 from conftest import REPO, copy_workflow, python_path
 from stickslip.fem.backends.cuda import CudaBackend
-from stickslip.study import Study
+from stickslip.study_plan import Study
 
 CLUSTER = REPO / "tests" / "slurm" / "cluster.sh"
 CI = ["--configfile", "workflow/config/ci.yaml"]

@@ -13,7 +13,7 @@ from stickslip import vocabulary
 from stickslip.cli import main
 from stickslip.errors import RunNotFoundError, StudyNotFoundError
 from stickslip.h5io import FileFormatError
-from stickslip.params import ParameterError
+from stickslip.plugin_params import ParameterError
 from stickslip.workdir import ENVIRONMENT
 
 pytestmark = pytest.mark.slow

@@ -20,9 +20,9 @@ import pytest
 
 from conftest import copy_workflow, python_path
 from stickslip import registry
-from stickslip.params import ParameterError, parse_params
+from stickslip.plugin_params import ParameterError, parse_params
 from stickslip.provenance.record import REQUIRED_FIELDS, read_record
-from stickslip.study import Study, check_sweeps
+from stickslip.study_plan import Study, check_sweeps
 
 TOY_CONFIG = {
     "threads": 1,
@@ -263,7 +263,7 @@ def test_solvers_that_read_a_mesh_share_one_mesh_job():
     import dataclasses
 
     from stickslip import mesh
-    from stickslip.params import param
+    from stickslip.plugin_params import param
 
     @dataclasses.dataclass(frozen=True)
     class MeshedParams:

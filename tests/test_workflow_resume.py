@@ -9,7 +9,7 @@ import pytest
 
 from stickslip import registry
 from stickslip.h5io import open_file, write_dataset
-from stickslip.params import param
+from stickslip.plugin_params import param
 from stickslip.workflow_api import partial_path, release_completed, run_simulation
 
 

@@ -8,7 +8,7 @@ import yaml
 
 from conftest import REPO
 from stickslip.provenance.record import REQUIRED_FIELDS, read_record
-from stickslip.study import Study
+from stickslip.study_plan import Study
 from test_workflow import snakemake
 
 

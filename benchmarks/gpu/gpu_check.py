@@ -139,16 +139,16 @@ def part_sanity(out):
     mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
     response = affine_response(params, mesh)
     cpu = kicked(params, mesh, make_backend(), response)
-    cpu.stack.backend.advance(steps)
-    reference = cpu.stack.backend.read("u", "v", "idx")
+    cpu.backend.advance(steps)
+    reference = cpu.backend.read("u", "v", "idx")
     states = {}
     for groups in SIZES["sanity_groups"]:
         start = time.perf_counter()
         backend = CudaBackend(groups=groups)
         gpu = kicked(dataclasses.replace(params, backend="cuda"), mesh, backend, response)
-        gpu.stack.backend.advance(steps)
-        states[groups] = gpu.stack.backend.read("u", "v", "idx")
-        used = sorted(gpu.stack.backend.batch.launcher.groups_used)
+        gpu.backend.advance(steps)
+        states[groups] = gpu.backend.read("u", "v", "idx")
+        used = sorted(gpu.backend.batch.launcher.groups_used)
         emit(out, part="sanity", groups=groups, blocks_used=used, seconds=time.perf_counter() - start,
              u_vs_cpu=float(np.abs(states[groups][0] - reference[0]).max() / np.abs(reference[0]).max()),
              wells_equal_cpu=bool(np.array_equal(states[groups][2], reference[2])))
@@ -160,14 +160,14 @@ def part_sanity(out):
 def _reference_run(path):
     from stickslip.fem.backends.cuda import CudaBackend
     from stickslip.fem.parameters import FemParams
-    from stickslip.fem.run import run_simulation
+    from stickslip.fem.run import simulate_to_file
     from stickslip.mesh import MeshParams, build_stack_mesh
 
     params = FemParams(N=9, plates=2, seed=0, k_drive=1e-3, drive="fixed-lever", nchunk=200, yield_strains="stop",
                        max_increments=SIZES["reference_increments"], relaxation=SIZES["relaxation"],
                        quiet_steps=SIZES["quiet_steps"], backend="cuda")
     start = time.perf_counter()
-    run_simulation(params, path, build_stack_mesh(MeshParams(N=9, plates=2)), CudaBackend(groups=1),
+    simulate_to_file(params, path, build_stack_mesh(MeshParams(N=9, plates=2)), CudaBackend(groups=1),
                    producer=PRODUCER)
     return time.perf_counter() - start
 
@@ -177,7 +177,7 @@ def part_fidelity(out):
 
     from stickslip.fem.backends.cuda import CudaBackend, run_ensemble
     from stickslip.fem.parameters import FemParams
-    from stickslip.fem.run import run_simulation
+    from stickslip.fem.run import simulate_to_file
     from stickslip.fem.stiffness import PAPER_PHI
     from stickslip.formats.fem_run import read_increments
     from stickslip.mesh import MeshParams, build_stack_mesh
@@ -210,10 +210,10 @@ def part_fidelity(out):
 
     start = time.perf_counter()
     for seed in seeds:
-        run_simulation(params(seed), directory / f"alone-{seed}.h5", mesh, CudaBackend(), producer=PRODUCER)
+        simulate_to_file(params(seed), directory / f"alone-{seed}.h5", mesh, CudaBackend(), producer=PRODUCER)
     alone = time.perf_counter() - start
     start = time.perf_counter()
-    run_ensemble([lambda backend, seed=seed: run_simulation(params(seed), directory / f"batch-{seed}.h5", mesh, backend,
+    run_ensemble([lambda backend, seed=seed: simulate_to_file(params(seed), directory / f"batch-{seed}.h5", mesh, backend,
                                                             producer=PRODUCER) for seed in seeds])
     equal = [(directory / f"alone-{seed}.h5").read_bytes() == (directory / f"batch-{seed}.h5").read_bytes()
              for seed in seeds]
@@ -233,9 +233,9 @@ def _speed(out, plates):
     mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
     response = affine_response(dataclasses.replace(params, backend="structured"), mesh)
     sim = kicked(params, mesh, CudaBackend(), response)
-    model, state = sim.stack.model, sim.stack.stored()
+    model, state = sim.model, sim.stack.stored()
     for count, groups in [(1, g) for g in SIZES["alone_groups"]] + [(b, None) for b in SIZES["batches"]]:
-        batch = DeviceBatch(sim.stack.backend.batch.mesh, model.law, count, groups)
+        batch = DeviceBatch(sim.backend.batch.mesh, model.law, count, groups)
         members = [CudaBackend().bound(model, mesh, batch) for _ in range(count)]
         for member in members:
             member.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
@@ -284,7 +284,7 @@ def _events(out, backend_name, N, regime, count):
         start = time.perf_counter()
         sim.protocol.kick(params.margin)
         seconds.append(time.perf_counter() - start)
-        steps.append(round((sim.stack.time - t0) / sim.stack.model.dt))
+        steps.append(round((sim.stack.time - t0) / sim.model.dt))
         emit(out, part="events", backend=backend_name, N=N, plates=plates, regime=regime, relaxation=params.relaxation,
              setup_seconds=setup, steps=steps[-1], seconds=seconds[-1],
              us_per_step=1e6 * seconds[-1] / max(steps[-1], 1),
@@ -310,9 +310,9 @@ def part_cpu_step(out):
         params = FemParams(N=N, plates=plates, nchunk=200)
         mesh = build_stack_mesh(MeshParams(N=N, plates=plates))
         sim = kicked(params, mesh, make_backend(), affine_response(params, mesh))
-        sim.stack.backend.advance(20)
+        sim.backend.advance(20)
         start = time.perf_counter()
-        sim.stack.backend.advance(steps)
+        sim.backend.advance(steps)
         per_step = (time.perf_counter() - start) / steps
         emit(out, part="cpu-step", backend="structured", threads=1, N=N, plates=plates, elements=mesh.nelem,
              us_per_step=per_step * 1e6, element_steps_per_s=mesh.nelem / per_step)

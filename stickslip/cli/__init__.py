@@ -16,9 +16,10 @@ import sys
 import textwrap
 import warnings
 
+from .. import __version__
 from ..h5io import FileFormatError
 from ..output_safety.errors import OutputError
-from ..params import ParameterError, ParameterWarning
+from ..plugin_params import ParameterError, ParameterWarning
 from ..registry import PluginError
 from ..termination import exit_status, interrupts_raised, interruption
 
@@ -56,8 +57,6 @@ def add_overwrite_option(parser):
 
 def build_parser():
     """Return the top-level argument parser with every sub-command."""
-    from .. import __version__
-
     parser = argparse.ArgumentParser(prog="stickslip", description=DESCRIPTION, epilog=EPILOG,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")

@@ -16,7 +16,7 @@ from ..experiment.analysis import ExperimentEventsParams, analyse_record
 from ..experiment.plausibility import force_rate_warning, missing_drop_error, no_slip_warning, travel_warning
 from ..experiment.timeseries import read_timeseries
 from ..output_safety.overwrite import write_text_output
-from ..params import ParameterError, parse_assignments, parse_params
+from ..plugin_params import ParameterError, parse_assignments, parse_params
 from ..progress import iterate
 from . import add_overwrite_option
 

@@ -19,9 +19,13 @@ from pathlib import Path
 import pandas as pd
 
 from ..h5io import FileFormatError
-from ..params import ParameterError, parse_assignments
+from ..plugin_params import ParameterError, parse_assignments
+from ..provenance import query
 from ..provenance.filters import EVENT_FILTERS, RUN_FILTERS
+from ..provenance.ingest import find_records, ingest
+from ..provenance.migrate import migrate
 from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
+from ..study_plan import check_study_name
 from ..workdir import ENVIRONMENT, find_workdir
 
 FORMATS = ("table", "csv", "json")
@@ -41,7 +45,6 @@ EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regi
 
 def _study(name):
     """``--study``: a study's name, a directory under results/ (``..`` or a path would leave it)."""
-    from ..study import check_study_name
 
     try:
         return check_study_name(name, "a study name")
@@ -214,8 +217,6 @@ def _write(frame, args, columns):
 
 def _query(args, name, columns=None, *positional, **filters):
     """Run ``query.<name>`` on the database of ``args`` and print it; a failed query is one line, exit 2."""
-    from ..provenance import query
-
     try:
         frame = getattr(query, name)(*positional, _database(args), **filters)
     except query.QueryError as error:
@@ -242,8 +243,6 @@ def run_sql(args):
 
 def run_ingest(args):
     """``db ingest``."""
-    from ..provenance.ingest import ingest
-
     counts = ingest(_database(args, exists=False), args.records)
     print(", ".join(f"{count} {name}" for name, count in counts.items()) + " ingested")
     return 0
@@ -251,8 +250,6 @@ def run_ingest(args):
 
 def run_rebuild(args):
     """``db rebuild``."""
-    from ..provenance.ingest import find_records, ingest
-
     results = args.results or _results(args)
     records = find_records(results)
     if not records:
@@ -265,8 +262,6 @@ def run_rebuild(args):
 
 def run_migrate(args):
     """``db migrate``."""
-    from ..provenance.migrate import migrate
-
     database = _database(args)
     before, after = migrate(database)
     print(f"{database}: schema {before}" + (f" migrated to {after}" if before != after else ", nothing to migrate"))

@@ -4,7 +4,7 @@ from pathlib import Path
 
 from ..mesh import MeshParams, mesh_id, read_mesh, write_mesh
 from ..output_safety.overwrite import claimed_output
-from ..params import describe, parse_assignments, parse_params
+from ..plugin_params import describe, parse_assignments, parse_params
 from . import add_overwrite_option
 
 

@@ -1,7 +1,7 @@
 """``stickslip plugins``: list the registered solvers, analyses and figures, with their contracts, and the formats."""
 
 from .. import formats, registry
-from ..params import describe
+from ..plugin_params import describe
 
 PLURAL = {"solver": "solvers", "analysis": "analyses", "figure": "figures"}
 

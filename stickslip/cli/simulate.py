@@ -5,7 +5,7 @@ import os
 from pathlib import Path
 
 from ..arithmetic import CONTINUE_VARIABLE
-from ..params import parse_assignments
+from ..plugin_params import parse_assignments
 from ..solver_run import run_solver
 from . import add_overwrite_option
 

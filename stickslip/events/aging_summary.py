@@ -31,7 +31,7 @@ import pandas as pd
 from ..experiment.aging import fit_aging
 from ..formats.analysis_file import open_analysis_file
 from .omori import bootstrap_omori
-from .results import read_analysis_file
+from .analysis_files import read_analysis_file
 
 __all__ = ["TABLES", "load_aging_runs", "select_runs", "first_peaks", "trial_peaks", "paired_slopes", "curvature", "ratio", "rate_slope",
            "estimator", "aftershock_pairs", "driven_aftershocks", "mean_sem"]
@@ -58,7 +58,7 @@ def load_aging_runs(paths):
     pandas.DataFrame
         ``file``, ``trials`` (the analysis's ``hold_interfaces``: the runs it made trials in; a study may
         analyse its runs with several parameterisations), ``n``, ``seed``, ``temperature``, ``drive_rate``, ``strengthening`` (0 without aging), ``T0`` and
-        ``data`` (:class:`.results.AnalysisFile`); only thermal runs.
+        ``data`` (:class:`.analysis_files.AnalysisFile`); only thermal runs.
     """
     rows = []
     for path in sorted(map(str, paths)):
@@ -227,7 +227,7 @@ def aftershock_pairs(items, n, samples=200):
 
     Parameters
     ----------
-    items : Sequence[stickslip.events.results.AnalysisFile]
+    items : Sequence[stickslip.events.analysis_files.AnalysisFile]
         Runs with ``n`` interfaces and aftershock trials.
     n : int
     samples : int

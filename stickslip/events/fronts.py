@@ -39,7 +39,7 @@ from ..formats.front_table import FAILURE_DTYPES, FORMAT, FRONT_DTYPES
 from ..h5io import FileFormatError
 from ..lineage import Artifact
 from ..mesh import interface_layer
-from ..params import ParameterError, param
+from ..plugin_params import ParameterError, param
 from ..progress import iterate
 from ..registry import register
 from . import extraction

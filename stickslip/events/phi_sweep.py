@@ -60,7 +60,7 @@ def sweep_table(files, phi_of):
 
     Parameters
     ----------
-    files : Iterable[stickslip.events.results.AnalysisFile]
+    files : Iterable[stickslip.events.analysis_files.AnalysisFile]
         ``numerical-events`` files with tables ``slips`` and ``slip_interfaces``.
     phi_of : Callable[[dict], float]
         Phi of a file from its attributes.

@@ -39,7 +39,7 @@ def run_key(item):
 
     Parameters
     ----------
-    item : stickslip.events.results.AnalysisFile
+    item : stickslip.events.analysis_files.AnalysisFile
 
     Returns
     -------
@@ -57,7 +57,7 @@ def periodicity_by_size(files):
 
     Parameters
     ----------
-    files : Iterable[stickslip.events.results.AnalysisFile]
+    files : Iterable[stickslip.events.analysis_files.AnalysisFile]
         ``numerical-events`` files read with the table ``periodicity``.
 
     Returns
@@ -74,7 +74,7 @@ def drop_shift_by_size(files, reference=1):
 
     Parameters
     ----------
-    files : Iterable[stickslip.events.results.AnalysisFile]
+    files : Iterable[stickslip.events.analysis_files.AnalysisFile]
         ``numerical-events`` files read with the table ``slip_interfaces``.
     reference : int, optional
         The n the others are compared with.
@@ -123,7 +123,7 @@ def front_speed_by_size(files):
 
     Parameters
     ----------
-    files : Iterable[stickslip.events.results.AnalysisFile]
+    files : Iterable[stickslip.events.analysis_files.AnalysisFile]
         ``front-dynamics`` files read with the table ``fronts``.
 
     Returns

@@ -50,8 +50,9 @@ from .. import progress
 from ..experiment.aging import aging_rate, slow_slip_fraction
 from ..formats.analysis_file import write_analysis_file
 from ..formats.event_table import slip_events_table
+from ..formats.fem_run import read_increments, read_run_attrs
 from ..h5io import FileFormatError
-from ..params import param
+from ..plugin_params import param
 from ..registry import register
 from . import extraction
 from .aging_trials import aftershock_tables, trial_slip_table
@@ -221,8 +222,6 @@ def hold_tables(hold, states, params, T0, n_interfaces, results=None):
 @register("analysis", NAME, VERSION, ThermalEventParams, consumes=("fem-run",), produces="event-table")
 def run(params, input, output):
     """Slips with waiting times and aging rates, slow slip, and hold trials (thermal runs) of a fem run."""
-    from ..formats.fem_run import read_increments, read_run_attrs
-
     run_attrs = read_run_attrs(input)
     if "N" not in run_attrs:
         raise FileFormatError(f"{input}: run attributes lack N")

@@ -27,7 +27,7 @@ import pandas as pd
 from .. import h5io, registry
 from ..formats.analysis_file import write_analysis_file
 from ..formats.event_table import slip_events_table
-from ..params import ParameterError, param
+from ..plugin_params import ParameterError, param
 from . import aging, detection, kinematics
 from .timeseries import read_timeseries
 

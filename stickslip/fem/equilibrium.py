@@ -129,7 +129,7 @@ class WellEquilibrium:
         woodbury_correct(y, self._gain, *self._U, self._Z)
         return y
 
-    def relax(self, backend, tol):
+    def move_to_equilibrium(self, backend, tol):
         """Move the backend's state to the equilibrium of its current wells, if it keeps every point in its well.
 
         From the state at rest (``v = a = 0``) with every Gauss point held in its well, the

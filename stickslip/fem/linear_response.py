@@ -2,7 +2,7 @@
 
 Along it the interface strain changes linearly, which the event-driven steps use
 (:mod:`.loading`). It is the equilibrium of the stack with every interface block elastic
-(:class:`.laws.Elastic`), in a model and state of its own (:meth:`.backends.base.Backend.for_model`):
+(:class:`.laws.Elastic`), in a model and state of its own (:meth:`.stack.Stack.backend_for`):
 fixed lever, targets ``2 eps0 H_l`` (affine simple shear ``gamma = eps0``); free lever, lever
 drive target ``eps0``. Then scaled so that the largest interface equivalent strain is 0.1 of the
 narrowest well of the first ``nchunk`` (:func:`.event_driven.autoscale`).
@@ -26,12 +26,14 @@ LinearResponse = namedtuple("LinearResponse", [
 ])
 
 
-def compute_linear_response(stack, relaxation, params, mesh):
+def compute_linear_response(stack, model, relaxation, params, mesh):
     """The scaled linear response of a stack (module docstring); the stack's own state is not changed.
 
     Parameters
     ----------
     stack : stickslip.fem.stack.Stack
+    model : stickslip.fem.model.Model
+        The stack's model.
     relaxation : stickslip.fem.relaxation.DynamicRelaxation
         ``dynamic``: minimised from rest by damped dynamics (the paper's protocol); ``exact``: one
         direct solve with the run's factorisation (the model is linear).
@@ -42,10 +44,9 @@ def compute_linear_response(stack, relaxation, params, mesh):
     -------
     LinearResponse
     """
-    model = stack.model
     elastic = model._replace(law=Elastic(params.K, params.G),
                              epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
-    backend = stack.backend.for_model(elastic)
+    backend = stack.backend_for(elastic)
     unit_target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height, dtype=np.float64)
     backend.set_state(np.zeros(model.ndof), unit_target, params.eps0, 0.0)
     relaxation.equilibrate_linear(backend)

@@ -1,13 +1,11 @@
 """Quasistatic loading of a stack along its linear response: elastic steps to the brink of yielding, kicks past it.
 
-The load direction (:class:`.linear_response.LinearResponse`) is given to the backend once
-(:meth:`.backends.base.Backend.set_load_direction`); a step along it moves the displacement and
-the drive together (:meth:`.backends.base.Backend.load`). The step to the brink, or just past
+The load direction (:class:`.linear_response.LinearResponse`) is given to the stack once
+(:meth:`.stack.Stack.set_load_direction`); a step along it moves the displacement and
+the drive together (:meth:`.stack.Stack.load`). The step to the brink, or just past
 it, is found on the host from the interface strain (:func:`.event_driven.step_size`).
 Reference: shared/reference-model.md, section 8a-8b.
 """
-
-import numpy as np
 
 from .errors import SolverError
 from .event_driven import step_size
@@ -21,16 +19,19 @@ class Loading:
     Parameters
     ----------
     stack : stickslip.fem.stack.Stack
+    model : stickslip.fem.model.Model
+        The stack's model (its interface elements; the held yield strains are the stack's).
     response : stickslip.fem.linear_response.LinearResponse
     deps : float
         Kick size in equivalent strain (:func:`.constants.derived_constants`).
     """
 
-    def __init__(self, stack, response, deps):
+    def __init__(self, stack, model, response, deps):
         self.stack = stack
+        self.model = model
         self.response = response
         self.deps = deps
-        stack.backend.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
+        stack.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
 
     def step_size(self, kick, yield_element=False, bisect=True):
         """The step along the linear response that :meth:`step` makes (nothing is changed).
@@ -55,10 +56,10 @@ class Loading:
         SolverError
             If no yielding step exists.
         """
-        m = self.stack.model
-        u, eps, idx = self.stack.backend.read("u", "eps", "idx")
+        m, stack = self.model, self.stack
+        u, eps, idx = stack.read("u", "eps", "idx")
         r = self.response
-        step = step_size(m.epsy, m.iface_dofs, m.iface_dNdx, u, r.delta_u, eps, r.delta_eps, idx, self.deps, kick,
+        step = step_size(stack.yield_strains, m.iface_dofs, m.iface_dNdx, u, r.delta_u, eps, r.delta_eps, idx, self.deps, kick,
                          yield_element and kick, bisect)
         if step < 0.0:
             raise SolverError("no step along the linear response makes a block yield")
@@ -66,7 +67,7 @@ class Loading:
 
     def load(self, step):
         """Move the state by ``step`` along the linear response (displacement and drive; no dynamics)."""
-        self.stack.backend.load(step)
+        self.stack.load(step)
 
     def step(self, kick, yield_element=False):
         """Elastic load step to the brink of yielding, or kick past it (no dynamics).
@@ -88,10 +89,10 @@ class Loading:
             If no yielding step exists or the step broke its promise (an index changed
             during a load step, or none during a kick).
         """
-        idx = self.stack.backend.read("idx")[0].copy()
+        token = self.stack.watch()
         step = self.step_size(kick, yield_element)
         self.load(step)
-        changed = np.any(self.stack.backend.read("idx")[0] != idx)
+        changed = self.stack.moved(token)
         if kick and not changed:
             # the step is found with the CPU's arithmetic, to just past a yield strain; a backend of other round-off
             # (a GPU's fused multiply-adds) can leave the point a rounding error short of it: kick again from where
@@ -100,7 +101,7 @@ class Loading:
             extra = self.step_size(kick, yield_element, bisect=False)
             self.load(extra)
             step += extra
-            changed = np.any(self.stack.backend.read("idx")[0] != idx)
+            changed = self.stack.moved(token)
         if kick != changed:
             raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
                               f"{'did not change' if kick else 'changed'}")

@@ -82,6 +82,7 @@ class Observer:
     def __init__(self, simulation):
         mesh = simulation.mesh
         self.stack = simulation.stack
+        self.model = simulation.model
         self.params = simulation.params
         self.sig0 = simulation.constants["sig0"]
         xe = element_coordinates(mesh.coor, mesh.conn)
@@ -114,9 +115,9 @@ class Observer:
         dict[str, float]
             Keys :func:`observable_columns`.
         """
-        u, sig, target, ubar, lever, t = self.stack.backend.read("u", "sig", "target", "ubar", "lever", "t")
+        u, sig, target, ubar, lever, t = self.stack.read("u", "sig", "target", "ubar", "lever", "t")
         p = self.params
-        model = self.stack.model
+        model = self.model
         eps0, sig0 = p.eps0, self.sig0
         eps_sum = layer_strain_sums(u, self.edofs, self.dNdx, self.dV, self.elem_layer, self.nlayer)
         sig_sum = np.empty_like(eps_sum)

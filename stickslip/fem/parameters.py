@@ -10,7 +10,7 @@ import math
 import warnings
 
 from ..formats import fem_run
-from ..params import ParameterError, ParameterWarning, param, parse_params
+from ..plugin_params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
 from .thermal.junctions import expected_redraws
@@ -305,7 +305,7 @@ def stored_params(file):
     ------
     stickslip.h5io.FileFormatError
         If the file is not a ``fem-run`` file of the current version.
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         If its parameters are not those of a :class:`FemParams`.
     """
     return parse_params(FemParams, fem_run.read_params(file), owner=f"{file.filename}: params")

@@ -72,6 +72,7 @@ class AthermalProtocol:
     def perturb_and_relax(self, perturbation, margin, record=False):
         """Perturb the stack and relax it; with ``extend``, redone until the held wells suffice.
 
+        The stack relaxes (:meth:`.stack.Stack.relax`: with ``extend`` the wells are then held ahead).
         With ``yield_strains = extend``, a relaxation that comes within ``margin`` wells of the end
         of the held wells is discarded: the state before the perturbation is restored, the windows
         are widened (doubled) and the perturbation redone, which gives the state a longer sequence
@@ -98,10 +99,10 @@ class AthermalProtocol:
         stack = self.stack
         before = stack.stored()
         while True:
-            index = stack.backend.read("idx")[0][:, 0].copy()
+            token = stack.watch()
             perturbation.apply()
-            kicked = stack.backend.read("idx")[0][:, 0] - index
-            niter, events = self.relaxation.relax(stack.backend, margin, record)
+            kicked = stack.well_changes(token)[:, 0]
+            niter, events = stack.relax(self.relaxation, margin, record)
             if niter or not stack.extend:
                 break
             stack.restore(*before)
@@ -117,8 +118,7 @@ class AthermalProtocol:
         :meth:`perturb_and_relax` with the kick along the linear response; if the relaxation ends
         with no well index changed (the kicked point fell back), the state before the kick is
         restored and the kick redone so that all Gauss points of one element yield
-        (``yield_element``). With ``yield_strains = extend``, the held wells are then moved ahead
-        (:meth:`.stack.Stack.hold_wells_ahead`).
+        (``yield_element``).
 
         Parameters
         ----------
@@ -134,12 +134,10 @@ class AthermalProtocol:
         """
         stack = self.stack
         before = stack.stored()
-        index = stack.well_index()
+        token = stack.watch()
         niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, False), margin)
-        fallback = niter != 0 and np.array_equal(stack.well_index(), index)
+        fallback = niter != 0 and not stack.moved(token)
         if fallback:
             stack.restore(*before)
             niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, True), margin)
-        if niter != 0 and stack.extend:
-            stack.hold_wells_ahead()
         return niter != 0, fallback

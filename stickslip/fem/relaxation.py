@@ -125,7 +125,7 @@ class ExactRelaxation(DynamicRelaxation):
         bool
             True if the state (now at rest) was replaced; else it is unchanged.
         """
-        return self.equilibrium.relax(backend, self.tol)
+        return self.equilibrium.move_to_equilibrium(backend, self.tol)
 
     _solved = solve_in_wells
 

@@ -112,7 +112,7 @@ class EventReplay:
         """
         stack = self.simulation.stack
         stack.restore(*self._state(increment))
-        eps, sig = stack.backend.read("eps", "sig")
+        eps, sig = stack.read("eps", "sig")
         return {"eps": eps.reshape(-1, self.N, 4, 3).copy(), "sig": sig.reshape(-1, self.N, 4, 3).copy(),
                 "well": stack.well_index().reshape(-1, self.N, 4)}
 
@@ -151,7 +151,7 @@ class EventReplay:
         s.stack.restore(*before)
         kick = KickAlongResponse(s.loading, bool(self._yield_element[increment]))
         niter, events = s.protocol.perturb_and_relax(kick, self.params.margin, record=True)
-        u, t = s.stack.backend.read("u", "t")
+        u, t = s.stack.read("u", "t")
         if niter == 0 or not np.array_equal(u, after[0]) or t[0] != after[3]:
             raise AssertionError(f"{self.path}: replaying increment {increment} did not reproduce the stored state")
         element = events[:, 0].astype(np.int64)

@@ -31,14 +31,14 @@ from ..output_safety.atomic import atomic_output
 from ..output_safety.lock import writer_lock
 from ..output_safety.overwrite import changed_values, set_aside
 from ..output_safety.space import check_free_space
-from ..params import params_to_dict
+from ..plugin_params import params_to_dict
 from .backends import backend_arithmetic
 from .observables import Observer, observable_columns
 from .parameters import stored_params
 from .simulation import Simulation
 from .stiffness import driving_regime, stiffness_ratio
 
-__all__ = ["run_simulation"]
+__all__ = ["simulate_to_file"]
 
 #: Free space kept beyond one increment's chunks [B]: HDF5 crashes if a write for lack of space
 #: fails in the file appended to, so the loop stops cleanly (OutputError) before the disk is full.
@@ -92,7 +92,7 @@ def _create(path, params, mesh, backend, producer):
     simulation = Simulation(params, mesh, backend)
     observer = Observer(simulation)
     protocol = simulation.protocol
-    columns = observable_columns(observer.nlayer, observer.n_interfaces, simulation.stack.model.free_lever)
+    columns = observable_columns(observer.nlayer, observer.n_interfaces, simulation.model.free_lever)
     with atomic_output(path) as tmp:
         with open_file(tmp, "w") as file:
             create_file(file, _header(simulation, observer, producer), mesh, simulation.loading.response,
@@ -128,7 +128,7 @@ def _stored(output, params):
     return completed
 
 
-def run_simulation(params, output, mesh, backend, *, producer):
+def simulate_to_file(params, output, mesh, backend, *, producer):
     """Run (or resume, or skip if completed) one simulation into ``output``.
 
     While the run is going, ``output`` is appended in SWMR mode (readable meanwhile,

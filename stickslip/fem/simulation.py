@@ -10,7 +10,7 @@ from .linear_response import LinearResponse, compute_linear_response
 from .loading import Loading
 from .protocol import AthermalProtocol
 from .relaxation import make_relaxation
-from .stack import build_stack
+from .stack import Stack, stack_model
 from .thermal import thermal_protocol
 
 __all__ = ["Simulation", "make_protocol"]
@@ -28,7 +28,7 @@ def make_protocol(simulation, table=None):
     """
     s = simulation
     if s.params.temperature > 0.0:
-        return thermal_protocol(s.stack, s.loading, s.relaxation, s.params, s.mesh, s.constants, table)
+        return thermal_protocol(s.stack, s.model, s.loading, s.relaxation, s.params, s.mesh, s.constants, table)
     return AthermalProtocol(s.stack, s.loading, s.relaxation)
 
 
@@ -52,6 +52,11 @@ class Simulation:
     params, mesh
     constants : dict
         :func:`.constants.derived_constants`.
+    model : stickslip.fem.model.Model
+        The stack's model (its yield strains those at the origin; :attr:`.stack.Stack.yield_strains` the held ones).
+    backend : stickslip.fem.backends.base.Backend
+        The prepared backend, for backend-level tests and benchmarks only: the package reads and changes the state
+        through ``stack``.
     stack : stickslip.fem.stack.Stack
     relaxation : stickslip.fem.relaxation.DynamicRelaxation
     loading : stickslip.fem.loading.Loading
@@ -62,9 +67,11 @@ class Simulation:
         self.params = params
         self.mesh = mesh
         self.constants = derived_constants(params, mesh)
-        self.stack = build_stack(params, mesh, backend, self.constants)
-        self.relaxation = make_relaxation(params, self.constants, self.stack.model)
+        self.model, wells = stack_model(params, mesh, self.constants)
+        self.backend = backend.prepare(self.model, mesh)
+        self.stack = Stack(self.backend, wells, params.yield_strains == "extend")
+        self.relaxation = make_relaxation(params, self.constants, self.model)
         if response is None:
-            response = compute_linear_response(self.stack, self.relaxation, params, mesh)
-        self.loading = Loading(self.stack, LinearResponse(*response), self.constants["deps"])
+            response = compute_linear_response(self.stack, self.model, self.relaxation, params, mesh)
+        self.loading = Loading(self.stack, self.model, LinearResponse(*response), self.constants["deps"])
         self.protocol = make_protocol(self, table)

@@ -1,168 +1,196 @@
-"""The simulated stack: a backend that owns the state, and the window of yield strains it holds.
+"""The simulated stack: the one face of a state that a backend owns, and the window of yield strains it holds.
 
-Every block's sequence of yield strains is unbounded (:class:`.yield_strains.HeldYieldStrains`);
-the backend holds a window of it and numbers the wells from the window's start. :class:`Stack`
-keeps the two in step: a well's global index is the held index plus the window's offset, and
-with ``yield_strains = extend`` the windows are moved ahead of the Gauss points after every event
-(:meth:`Stack.hold_wells_ahead`), always through the backend (:meth:`.backends.base.Backend.set_yield_strains`).
-With junction aging (:mod:`.thermal.junctions`) the yield strains the backend holds are that window with
-every junction's well widened (:meth:`Stack.push_yield_strains`), and a stored state includes the junctions.
+The rest of the package reads and changes the state only through :class:`Stack`: its backend is private
+(a test greps the package for reach-throughs). The yield strains the backend holds are a window of the
+blocks' unbounded sequences (:class:`.window.HeldWindow`): a well's global index is the held index plus
+the window's offset, and with ``yield_strains = extend`` the windows are moved ahead of the Gauss points
+after every relaxation that moved something (:meth:`Stack.relax`). What the backend holds may be modified
+by one **yield-strain modifier** that a protocol registers (:meth:`Stack.modify_yield_strains`; junction
+aging): a stored state then includes the modifier's state as a fifth item. The stack imports nothing of
+the protocols.
 """
 
 import numpy as np
 
 from .errors import SolverError
 from .laws import make_law
-from .materials import equivalent_strains
 from .model import build_model
-from .thermal.junctions import Junctions
+from .window import HeldWindow
 from .yield_strains import HeldYieldStrains, interface_initstate
 
-__all__ = ["Stack", "build_stack"]
+__all__ = ["Stack", "stack_model"]
+
+
+def _read_only(array):
+    """A view of ``array`` that cannot be written."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 class Stack:
-    """The state of a simulated stack (in its backend) with the yield strains the backend holds.
+    """The state of a simulated stack (owned by its backend) with the yield strains the backend holds.
 
     Parameters
     ----------
     backend : stickslip.fem.backends.base.Backend
-        Prepared for the stack's model (it owns the state).
+        Prepared for the stack's model (it owns the state); private to the stack from then on.
     wells : HeldYieldStrains
-        The held windows of the blocks' yield-strain sequences; ``backend.model.epsy`` is ``wells.epsy``.
+        The held windows of the blocks' yield-strain sequences.
     extend : bool
-        ``yield_strains = extend``: the windows follow the Gauss points (else they hold the whole sequence).
-    junctions : stickslip.fem.thermal.junctions.Junctions, optional
-        Junction aging: the junctions that widen the blocks' current wells (None: no aging; then
-        ``backend.model.epsy`` is ``wells.epsy``).
-
-    Attributes
-    ----------
-    backend, wells, extend, junctions
+        ``yield_strains = extend``: the windows follow the Gauss points (else they hold the whole sequence); an
+        attribute of the same name.
     """
 
-    def __init__(self, backend, wells, extend, junctions=None):
-        self.backend = backend
-        self.wells = wells
+    def __init__(self, backend, wells, extend):
+        self._backend = backend
+        self._window = HeldWindow(backend, wells)
         self.extend = extend
-        self.junctions = junctions
 
     @property
-    def model(self):
-        """The backend's :class:`.model.Model` (read only)."""
-        return self.backend.model
+    def wells(self):
+        """The held windows (:class:`HeldYieldStrains`: read them; the stack moves them)."""
+        return self._window.wells
+
+    def modify_yield_strains(self, modifier):
+        """Register the yield-strain modifier (:mod:`.window`); the backend is given its yield strains at once."""
+        self._window.register(modifier)
+
+    @property
+    def modifier(self):
+        """The registered yield-strain modifier (None: none)."""
+        return self._window.modifier
 
     @property
     def time(self):
         """The clock [time]."""
-        return float(self.backend.read("t")[0][0])
+        return float(self._backend.read("t")[0][0])
 
     def set_time(self, t):
         """Set the clock [time]."""
-        self.backend.set_time(t)
+        self._backend.set_time(t)
+
+    def read(self, *fields):
+        """The state fields ``fields`` (:data:`.backends.base.FIELDS`), a tuple of read-only arrays."""
+        return self._backend.read(*fields)
+
+    @property
+    def yield_strains(self):
+        """The yield strains the backend holds now: the windows, modified (if a modifier is registered), float64
+        [ni, ny], read only (they change when the windows move)."""
+        return _read_only(self._backend.model.epsy)
 
     def well_index(self):
         """Global well index of every interface Gauss point (counted from the start of the sequence), int64 [ni, 4]."""
-        return self.backend.read("idx")[0] + self.wells.offset[:, None]
+        return self._backend.read("idx")[0] + self.wells.offset[:, None]
+
+    def watch(self):
+        """A token for :meth:`moved` and :meth:`well_changes`: the well of every Gauss point now."""
+        return self.well_index()
+
+    def moved(self, token):
+        """Whether a Gauss point changed well since :meth:`watch` gave ``token``."""
+        return not np.array_equal(self.well_index(), token)
+
+    def well_changes(self, token):
+        """Wells moved by every Gauss point since :meth:`watch` gave ``token``: int64 [ni, 4] (+ forward)."""
+        return self.well_index() - token
 
     def within_margin(self, margin):
         """True if every Gauss point is more than ``margin`` wells from the end of the held yield strains."""
-        return bool(np.all(self.backend.read("idx")[0] < self.wells.epsy.shape[1] - margin))
+        return bool(np.all(self._backend.read("idx")[0] < self.wells.epsy.shape[1] - margin))
 
     def stored(self):
         """Copies of what :meth:`restore` needs, the state stored per increment: (u, target, lever_target, t),
-        and with junctions their state (:meth:`.thermal.junctions.Junctions.stored`) as a fifth item."""
-        u, target, lever, t = self.backend.read("u", "target", "lever", "t")
+        and with a modifier its state (``stored()``) as a fifth item."""
+        u, target, lever, t = self._backend.read("u", "target", "lever", "t")
         state = (u.copy(), target.copy(), float(lever[0]), float(t[0]))
-        return state if self.junctions is None else (*state, self.junctions.stored())
+        return state if self.modifier is None else (*state, self.modifier.stored())
 
-    def restore(self, u, target, lever_target, t, junctions=None):
+    def restore(self, u, target, lever_target, t, modified=None):
         """Set a stored state (at rest) and, with ``extend``, move the windows to it (:meth:`hold_wells_ahead`).
 
         Parameters
         ----------
-        u : numpy.ndarray
-            [ndof] displacement.
-        target : numpy.ndarray
-            [nlayer] drive targets (fixed lever; recomputed for a free lever).
-        lever_target : float
-            Free lever: drive target ``x_target``.
-        t : float
-            Time.
-        junctions : dict, optional
-            The junctions' state (:meth:`.thermal.junctions.Junctions.stored`), set before the displacement.
+        u, target, lever_target, t
+            A stored state (:meth:`stored`): displacement [ndof], drive targets [nlayer] (recomputed for a free
+            lever), a free lever's drive target, time.
+        modified : dict, optional
+            The modifier's state (its ``stored()``), set before the displacement.
         """
-        if junctions is not None:
-            self.junctions.restore(junctions)
-            self.push_yield_strains()
-        self.backend.set_state(u, target, lever_target, t)
+        if modified is not None:
+            self.modifier.restore(modified)
+            self._window.push()
+        self._backend.set_state(u, target, lever_target, t)
         if self.extend:
             self.hold_wells_ahead()
 
-    def push_yield_strains(self, shift=None):
-        """Give the backend the yield strains it holds: the window, each junction's well widened (if any).
+    def set_load_direction(self, delta_u, delta_target, delta_lever):
+        """The direction of :meth:`load`: displacement [ndof], layer targets [nlayer], free lever's drive target."""
+        self._backend.set_load_direction(delta_u, delta_target, delta_lever)
+
+    def load(self, step):
+        """Move the displacement and the drive by ``step`` times the load direction (no dynamics)."""
+        self._backend.load(step)
+
+    def add_u(self, dofs, delta):
+        """Add ``delta`` [len(dofs)] to the displacement of ``dofs`` (int64), no dynamics."""
+        self._backend.add_u(dofs, delta)
+
+    def relax(self, relaxation, margin, record=False):
+        """Bring the stack to rest with ``relaxation``; with ``extend``, then hold the wells ahead.
 
         Parameters
         ----------
-        shift : numpy.ndarray, optional
-            int64 [ni]: the windows moved forward by this many values (:meth:`.backends.base.Backend.set_yield_strains`).
+        relaxation : stickslip.fem.relaxation.DynamicRelaxation or stickslip.fem.relaxation.ExactRelaxation
+        margin, record
+            As :meth:`.relaxation.DynamicRelaxation.relax`.
+
+        Returns
+        -------
+        niter : int
+            Time steps made (0: stopped by the margin).
+        events : numpy.ndarray
+            float64 [nevent, 3] (element, time, direction) if ``record``.
         """
-        epsy = self.wells.epsy if self.junctions is None else self.junctions.aged(self.wells)
-        self.backend.set_yield_strains(epsy, shift)
+        niter, events = relaxation.relax(self._backend, margin, record)
+        if niter and self.extend:
+            self.hold_wells_ahead()
+        return niter, events
+
+    def backend_for(self, model):
+        """A backend prepared for another model on the stack's mesh and drive, with a state of its own (the linear
+        response's elastic twin; :meth:`.backends.base.Backend.for_model`)."""
+        return self._backend.for_model(model)
+
+    def push_yield_strains(self):
+        """Give the backend the yield strains it holds anew (a modifier's state changed: :meth:`.window.HeldWindow.push`)."""
+        self._window.push()
 
     def widen_wells(self):
         """Hold twice as many wells per block (the window's start unchanged)."""
-        self.wells.widen(self.wells.epsy.shape[1] - 1)
-        self.push_yield_strains()
+        self._window.widen()
 
     def hold_wells_ahead(self):
-        """``yield_strains = extend``: hold at least half a window of wells ahead of every Gauss point.
-
-        A block with fewer than ``(ny - 1) // 2`` held wells ahead of its furthest Gauss
-        point has its window moved forward to start ``(ny - 1) // 4`` wells behind its
-        nearest one (or widened if its points are spread too far for that). A state
-        beyond the held wells (after :meth:`restore`) is followed to its wells; a state
-        behind them restarts the windows from the origin. The values held never change
-        the physics: they are the same numbers wherever the window is.
-        """
-        wells = self.wells
-        idx, eps = self.backend.read("idx", "eps")
-        if np.any((wells.offset > 0) & (idx.min(axis=1) == 0)
-                  & (equivalent_strains(eps).min(axis=1) <= wells.epsy[:, 0])):
-            wells.start(wells.epsy.shape[1] - 1)
-            self.push_yield_strains()
-        while True:
-            ny = wells.epsy.shape[1]
-            ahead, behind = (ny - 1) // 2, (ny - 1) // 4
-            idx, eps = self.backend.read("idx", "eps")
-            short = idx.max(axis=1) > ny - 1 - ahead
-            if not short.any():
-                return
-            beyond = equivalent_strains(eps).max(axis=1) > wells.epsy[:, -1]
-            shift = np.where(short, np.where(beyond, ny - 1 - behind, idx.min(axis=1) - behind), 0)
-            if np.any(short & (shift <= 0)):
-                self.widen_wells()
-                continue
-            wells.slide(shift)
-            self.push_yield_strains(shift)
+        """Hold at least half a window of wells ahead of every Gauss point (:meth:`.window.HeldWindow.hold_ahead`)."""
+        self._window.hold_ahead()
 
 
-def build_stack(params, mesh, backend, constants):
-    """The stack of a run at rest at the origin: its yield strains, its model, the backend prepared for it.
+def stack_model(params, mesh, constants):
+    """The model of a run's stack and the held windows of its yield strains (at the origin).
 
     Parameters
     ----------
     params : FemParams
     mesh : stickslip.mesh.LayeredMesh
-    backend : stickslip.fem.backends.base.Backend
-        Not yet prepared (:func:`.backends.make_backend`).
     constants : dict
         :func:`.constants.derived_constants`.
 
     Returns
     -------
-    Stack
-        With :class:`.thermal.junctions.Junctions` if ``junction_strengthening > 0`` (none drawn yet).
+    model : stickslip.fem.model.Model
+        Its ``epsy`` the windows' yield strains (a :class:`Stack` tells those held later, :attr:`Stack.yield_strains`).
+    wells : HeldYieldStrains
 
     Raises
     ------
@@ -182,8 +210,4 @@ def build_stack(params, mesh, backend, constants):
                         rho=params.rho, alpha=constants["alpha"], dt=constants["dt"], k_drive=params.k_drive,
                         drive_active=~plastic & (np.arange(mesh.nlayer) > 0), free_lever=params.drive == "free-lever",
                         lever_height=constants["H"])
-    junctions = None
-    if params.junction_strengthening > 0.0:
-        junctions = Junctions(wells.epsy.shape[0], params.junction_strengthening, params.junction_glass_temperature,
-                              params.junction_attempt_rate, params.eps0)
-    return Stack(backend.prepare(model, mesh), wells, extend, junctions)
+    return model, wells

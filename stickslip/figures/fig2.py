@@ -22,9 +22,9 @@ import dataclasses
 import numpy as np
 
 from ..events.extraction import interfaces_in, slip_fractions
-from ..events.results import group_runs, pooled
+from ..events.analysis_files import group_runs, pooled
 from ..events.mean_shift import shift_test
-from ..params import param
+from ..plugin_params import param
 from ..registry import register
 from .numerical_common import REGIME_LINESTYLE, read_inputs, run_phi
 from .periodicity_panels import MEASURE_LABEL, MEASURE_MARKER, periodicity_summary, plot_measure

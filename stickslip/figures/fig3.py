@@ -7,7 +7,7 @@ import numpy as np
 from matplotlib.ticker import NullFormatter
 
 from .. import registry
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, example_run, excerpt, load_slips
 from .plotting import a_style, hollow, label_panels, legend_outside, linear_edges
 from .experimental_panels import LABELS, distributions_by_n, positions_panel, single_slips

@@ -3,7 +3,7 @@
 import dataclasses
 
 from .. import registry
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_slips
 from .plotting import label_panels, legend_outside, linear_edges
 from .experimental_panels import distributions_by_n, single_slips

@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 
 from .. import registry
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_slips
 from .plotting import a_style, label_panels, legend_outside, log_edges
 from .experimental_panels import LABELS, aging_panel, disorder_law_lines, distributions_by_n, single_slips

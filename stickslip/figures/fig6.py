@@ -7,7 +7,7 @@ import numpy as np
 
 from .. import registry
 from ..experiment.aging import spread_of_aging_rate
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_interfaces, load_slips, median_run
 from .plotting import a_style, label_panels, legend_outside, linear_edges, plot_against_n
 from .experimental_panels import distributions_by_n, single_slips, slow_slip_fraction_panel

@@ -28,7 +28,7 @@ from .. import registry
 from ..events.aging_summary import estimator, load_aging_runs, mean_sem, paired_slopes, select_runs, trial_peaks
 from ..experiment.aging import log_binned
 from ..h5io import FileFormatError
-from ..params import param
+from ..plugin_params import param
 from .plotting import label_panels, n_style
 from .style import interface_color, plt, save_figure
 

@@ -24,7 +24,7 @@ from .. import h5io, registry
 from ..experiment import aging
 from ..formats import event_table
 from ..formats.analysis_file import open_analysis_file
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_slips
 from .experimental_panels import single_slips
 from .plotting import label_panels, legend_outside, plot_against_n

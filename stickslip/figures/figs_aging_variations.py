@@ -5,7 +5,7 @@ import dataclasses
 
 from .. import registry
 from ..experiment.aging import without_slow_slip
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_slips
 from .plotting import individual_style, label_panels, legend_outside
 from .experimental_panels import aging_panel, disorder_law_lines, single_slips

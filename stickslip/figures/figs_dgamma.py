@@ -9,8 +9,8 @@ import dataclasses
 
 import numpy as np
 
-from ..events.results import group_runs, pooled
-from ..params import param
+from ..events.analysis_files import group_runs, pooled
+from ..plugin_params import param
 from ..registry import register
 from .numerical_common import REGIME_LABEL, read_inputs
 from .plotting import label_panels, n_style, plot_density, range_edges

@@ -16,7 +16,7 @@ import dataclasses
 import numpy as np
 
 from ..events.fronts import BRANCHES
-from ..params import param
+from ..plugin_params import param
 from ..registry import register
 from .numerical_common import read_inputs
 from .style import plt, save_figure
@@ -80,7 +80,7 @@ def typical_events(files, n, regime, N=0):
 
     Parameters
     ----------
-    files : list[stickslip.events.results.AnalysisFile]
+    files : list[stickslip.events.analysis_files.AnalysisFile]
         ``front-dynamics`` files.
     n : int
     regime : str

@@ -7,7 +7,7 @@ import numpy as np
 from matplotlib.ticker import NullFormatter
 
 from .. import registry
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_slips
 from .plotting import a_style, label_panels, legend_outside, linear_edges, plot_density
 from .experimental_panels import LABELS, single_slips

@@ -11,7 +11,7 @@ import dataclasses
 import numpy as np
 
 from ..events.extraction import sequence_fractions
-from ..events.results import group_runs, pooled
+from ..events.analysis_files import group_runs, pooled
 from ..registry import register
 from .numerical_common import REGIME_LABEL, read_inputs
 from .plotting import label_panels
@@ -36,7 +36,7 @@ def fractions_by_n(groups, regime):
     Parameters
     ----------
     groups : dict[tuple[str, int], list[AnalysisFile]]
-        Output of :func:`stickslip.events.results.group_runs` (files with table ``sequences``).
+        Output of :func:`stickslip.events.analysis_files.group_runs` (files with table ``sequences``).
     regime : str
 
     Returns

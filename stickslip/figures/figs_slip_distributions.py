@@ -3,7 +3,7 @@
 import dataclasses
 
 from .. import registry
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_slips
 from .experimental_panels import distributions_by_n, single_slips
 from .plotting import legend_outside, linear_edges, log_edges

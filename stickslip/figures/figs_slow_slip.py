@@ -8,7 +8,7 @@ import numpy as np
 
 from .. import registry
 from ..experiment import detection
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, excerpt, load_interfaces, median_run
 from .plotting import label_panels, legend_outside
 from .experimental_panels import positions_panel, slow_slip_fraction_panel

@@ -10,8 +10,8 @@ import dataclasses
 
 import numpy as np
 
-from ..events.results import pooled
-from ..params import param
+from ..events.analysis_files import pooled
+from ..plugin_params import param
 from ..registry import register
 from .numerical_common import read_inputs
 from .style import interface_color, plt, save_figure

@@ -32,10 +32,10 @@ import numpy as np
 import pandas as pd
 
 from .. import registry
-from ..events.results import read_analysis_file
+from ..events.analysis_files import read_analysis_file
 from ..experiment.aging import fit_aging, log_binned
 from ..h5io import FileFormatError
-from ..params import param
+from ..plugin_params import param
 from .experimental_data import EVENTS, load_interfaces, load_slips
 from .plotting import a_style, hollow, label_panels, legend_outside, n_style, plot_against_n
 from .style import plt, save_figure
@@ -71,7 +71,7 @@ def load_runs(paths):
     pandas.DataFrame
         ``file``, ``thermal`` (bool), ``n``, ``drive_rate`` (NaN athermal), ``holds`` (bool: the run has
         hold cycles of its own), ``T0``, ``temperature``, and ``data`` (the
-        :class:`stickslip.events.results.AnalysisFile`).
+        :class:`stickslip.events.analysis_files.AnalysisFile`).
     """
     rows = []
     for path in sorted(map(str, paths)):

@@ -14,7 +14,7 @@ from matplotlib.collections import PolyCollection
 
 from ..h5io import FileFormatError, open_file
 from ..mesh import interface_layer, read_mesh, read_mesh_params
-from ..params import param
+from ..plugin_params import param
 from ..registry import register
 from .style import interface_color, plt, save_figure
 

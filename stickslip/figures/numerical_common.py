@@ -2,7 +2,7 @@
 figS-event-maps, figS-tau): reading their inputs, line styles per driving regime.
 """
 
-from ..events.results import read_analysis_file
+from ..events.analysis_files import read_analysis_file
 from ..fem.stiffness import at_paper_phi
 from ..formats import event_table, front_table
 from ..h5io import FileFormatError
@@ -44,7 +44,7 @@ def read_inputs(inputs, category, tables, figure, paper_phi=True):
 
     Returns
     -------
-    list[stickslip.events.results.AnalysisFile]
+    list[stickslip.events.analysis_files.AnalysisFile]
 
     Raises
     ------

@@ -30,7 +30,7 @@ def periodicity_rows(files, keys):
 
     Parameters
     ----------
-    files : Iterable[stickslip.events.results.AnalysisFile]
+    files : Iterable[stickslip.events.analysis_files.AnalysisFile]
         ``numerical-events`` files read with the table ``periodicity``.
     keys : Mapping[str, Callable[[AnalysisFile], object]]
         Column name -> value of a file (e.g. ``{"n": lambda f: f.n}``).

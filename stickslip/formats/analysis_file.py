@@ -19,7 +19,7 @@ the header's names win over copied ones.
 from .. import h5io
 from ..hashing import canonical_json, sha256_file
 from ..output_safety.atomic import atomic_output
-from ..params import params_to_dict
+from ..plugin_params import params_to_dict
 from . import check, stamp
 
 __all__ = ["HEADER", "write_analysis_file", "open_analysis_file"]

@@ -12,7 +12,7 @@ from .. import formats
 from ..h5io import FileFormatError, open_file, read_array, write_attrs, write_dataset
 from ..hashing import short_hash
 from ..output_safety.atomic import atomic_output
-from ..params import ParameterError, params_to_dict, parse_params
+from ..plugin_params import ParameterError, params_to_dict, parse_params
 from .layered import LayeredMesh, MeshParams, build_stack_mesh
 
 __all__ = ["MESH_FORMAT", "mesh_id", "save_mesh", "load_mesh", "read_mesh_params", "write_mesh", "read_mesh"]

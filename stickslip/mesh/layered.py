@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ..params import param
+from ..plugin_params import param
 from .stacking import stack_rows
 from .rows import (bottom_plate_rows, interface_rows, middle_plate_rows, plate_target_height,
                    top_plate_rows)

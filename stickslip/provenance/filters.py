@@ -4,7 +4,7 @@ A filter is a column of the database (its name, type and doc are the vocabulary'
 :mod:`stickslip.vocabulary`) or any parameter of a plugin (``backend="cpu"``, ``dt_scale=0.5``:
 :func:`stickslip.params`). Values are checked before the query: a filter that does not exist, a value of the
 wrong type or outside the choices (``regime="stif"``, ``source="lab"``) raises
-:class:`stickslip.params.ParameterError` naming it and what is allowed, as the command line refuses it, instead
+:class:`stickslip.plugin_params.ParameterError` naming it and what is allowed, as the command line refuses it, instead
 of returning an empty table. A value may be:
 
 - one value: rows equal to it (floats: to 6 significant digits, ``phi=5e-4``);
@@ -21,7 +21,7 @@ import math
 import numbers
 from collections.abc import Mapping
 
-from ..params import ParameterError, did_you_mean
+from ..plugin_params import ParameterError, did_you_mean
 from ..vocabulary import QUANTITIES
 
 __all__ = ["Filter", "RUN_FILTERS", "EVENT_FILTERS", "FLOAT_DIGITS", "check", "conditions", "with_filters"]
@@ -151,7 +151,7 @@ def check(specs, filters, *, known=None, parameters=None):
         The database's values of the ``choices="database"`` filters, by filter name.
     parameters : Mapping[str, list[tuple[str, object]]], optional
         Plugin parameter name -> ``[(plugin, parse(value)), ...]``: for each plugin that declares the parameter, a
-        function that checks a value and returns it converted (:func:`stickslip.params.parse_value`), and its
+        function that checks a value and returns it converted (:func:`stickslip.plugin_params.parse_value`), and its
         default. Needed only if ``filters`` names a parameter that is no column.
 
     Returns

@@ -28,7 +28,7 @@ from pathlib import Path
 from sqlalchemy import delete, insert
 from sqlalchemy.orm import Session
 
-from .. import formats, registry
+from .. import __version__, formats, registry
 from ..formats import event_table
 from ..h5io import FileFormatError
 from ..output_safety.atomic import atomic_output
@@ -202,8 +202,6 @@ def ingest(database, records, *, rebuild=False):
     Cost: reads every record, the header of every simulation and every ``slip_events``
     table; the database is copied once (its size) unless ``rebuild``.
     """
-    from .. import __version__
-
     registry.available("solver")  # plugins register the formats they write
 
     database = Path(database)

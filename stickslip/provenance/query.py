@@ -19,6 +19,7 @@ is restored after it (:class:`_Heap`).
 
 import _sqlite3
 import ctypes
+import dataclasses
 import itertools
 import math
 import numbers
@@ -34,7 +35,9 @@ import pandas as pd
 import sqlalchemy.exc
 from sqlalchemy import select, text
 
+from .. import registry
 from ..h5io import FileFormatError
+from ..plugin_params import parse_value
 from ..vocabulary import dtype_matches, expand_json, quantity, typed
 from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
@@ -325,11 +328,6 @@ _HELD = {"plugin": "runs", "solver": "simulations", "analysis": "slip_events"}
 
 def _parameters(names):
     """For each plugin parameter name: [(plugin, its value's parser, its default)] of every plugin declaring it."""
-    import dataclasses
-
-    from .. import registry
-    from ..params import parse_value
-
     found = {}
     for kind in registry.KINDS:
         for plugin in registry.available(kind).values():
@@ -389,7 +387,7 @@ def runs(database=DEFAULT_DATABASE, **filters):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         A filter that does not exist or a value that does not fit it (one line naming it).
 
     Notes
@@ -430,7 +428,7 @@ def events(database=DEFAULT_DATABASE, **filters):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         A filter that does not exist or a value that does not fit it.
 
     Notes

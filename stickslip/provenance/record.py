@@ -23,6 +23,7 @@ from contextlib import contextmanager
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
+from .. import __version__
 from ..arithmetic import decisive, host
 from ..h5io import FileFormatError
 from ..hashing import sha256_file
@@ -138,12 +139,6 @@ def library_versions():
     return versions
 
 
-def _package_version():
-    from .. import __version__
-
-    return __version__
-
-
 def _now():
     return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="milliseconds")
 
@@ -205,7 +200,7 @@ def _job_record(*, run_id, kind, plugin, plugin_version, code_hash, params, thre
     commit, dirty = git_state()
     return {
         "schema_version": SCHEMA_VERSION, "run_id": run_id, "kind": kind, "plugin": plugin,
-        "plugin_version": plugin_version, "code_hash": code_hash, "package_version": _package_version(),
+        "plugin_version": plugin_version, "code_hash": code_hash, "package_version": __version__,
         "git_commit": commit, "git_dirty": dirty, "params": params, "seed": params.get("seed"),
         "threads": threads, "versions": library_versions(), "host": socket.gethostname(),
         "arithmetic": {"decisive": decisive(), "host": host()},

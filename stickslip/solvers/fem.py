@@ -5,18 +5,20 @@ with its unit; ``stickslip plugins --params`` lists them). The mesh is read from
 ``inputs["mesh"]`` (a file of :func:`stickslip.mesh.write_mesh`) when given, else
 built from ``N`` and ``plates``. The output file (format ``fem-run``, :mod:`stickslip.formats.fem_run`)
 is appended after every increment; an existing incomplete file with the same
-parameters is resumed, a completed one is left as it is.
+parameters is resumed, a completed one is left as it is. Runs with ``backend = cuda`` share a GPU in
+batches (:data:`GPU_BATCHING`, the solver's ``device_batch``).
 """
 
 from .. import registry
 from ..fem.backends import make_backend
+from ..fem.backends.cuda import CudaBackend, run_ensemble
 from ..fem.parameters import FemParams
 from ..fem.replay import EventReplay
-from ..fem.run import run_simulation
+from ..fem.run import simulate_to_file
 from ..h5io import FileFormatError
 from ..mesh import MeshParams, build_stack_mesh, read_mesh
 
-__all__ = ["FemParams", "run", "stack_mesh", "can_run", "VERSION"]
+__all__ = ["FemParams", "run", "stack_mesh", "can_run", "VERSION", "GPU_BATCHING"]
 
 #: Algorithm version (part of every run id); bump when results change.
 VERSION = "4"  # 4: exact relaxation by QDLDL and fixed-order loops (host-independent bits); 3: stencil passes three entries at a time (round-off); 2: structured plate kernel, relaxation, dt_scale
@@ -51,17 +53,30 @@ def stack_mesh(params, inputs):
 
 
 def can_run(params):
-    """Raise :class:`stickslip.params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
+    """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
     make_backend(params.backend)
 
 
+def on_gpu(params):
+    """Whether a run of ``params`` (a defaults-filled dict) runs on a GPU: ``backend = cuda``."""
+    return params.get("backend") == CudaBackend.name
+
+
+#: Runs on a GPU in batches: what one batch shares (the device mesh, its operators, the law, the time step, the
+#: drive); they may differ in every other parameter (seed, drive stiffness, protocol, temperature, ...).
+GPU_BATCHING = registry.DeviceBatching(
+    on_device=on_gpu,
+    shared=("N", "plates", "K", "G", "rho", "dt_scale", "drive", "lever_height", "interface_law", "law_params"),
+    run=run_ensemble)
+
+
 @registry.register("solver", "fem", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay,
-                   preflight=can_run)
+                   preflight=can_run, device_batch=GPU_BATCHING)
 def run(params, output, *, threads=1, inputs=None, backend=None):
     """Finite-element model of the stack: event-driven quasistatic drive, inertial dynamics.
 
     ``backend``: a backend object of ``params.backend`` to run on (a GPU batch's,
     :func:`stickslip.workflow_api.run_simulation_batch`); default: a new one.
     """
-    run_simulation(params, output, stack_mesh(params, inputs), backend or make_backend(params.backend, threads),
+    simulate_to_file(params, output, stack_mesh(params, inputs), backend or make_backend(params.backend, threads),
                    producer=("fem", VERSION))

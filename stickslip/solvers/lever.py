@@ -27,7 +27,7 @@ import numpy as np
 from .. import registry
 from ..experiment.timeseries import PROTOCOLS, write_timeseries
 from ..experiment.virtual.model import apparatus, per_interface, simulate
-from ..params import ParameterError, param, params_to_dict
+from ..plugin_params import ParameterError, param, params_to_dict
 
 __all__ = ["LeverParams", "run", "check_protocol", "VERSION"]
 

@@ -26,7 +26,7 @@ from .. import registry
 from ..experiment.timeseries import write_timeseries
 from ..experiment.virtual.rate_state_model import simulate, slab_order
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS
-from ..params import ParameterError, param, params_to_dict
+from ..plugin_params import ParameterError, param, params_to_dict
 from .lever import LeverParams, check_protocol
 
 __all__ = ["RateStateLeverParams", "run", "VERSION"]

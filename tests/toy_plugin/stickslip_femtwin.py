@@ -12,7 +12,7 @@ solver: tests/test_fem_backends.py runs the same events through two of them.
 from stickslip.fem.backends import make_backend
 from stickslip.fem.parameters import FemParams
 from stickslip.fem.replay import EventReplay
-from stickslip.fem.run import run_simulation
+from stickslip.fem.run import simulate_to_file
 from stickslip.registry import register
 from stickslip.solvers.fem import stack_mesh
 
@@ -22,5 +22,5 @@ VERSION = "1"
 @register("solver", "fem-twin", VERSION, FemParams, consumes=("mesh",), produces="fem-run", replay=EventReplay)
 def run(params, output, *, threads, inputs):
     """The fem model under another name (test plugin: a second producer of the fem-run format)."""
-    run_simulation(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
+    simulate_to_file(params, output, stack_mesh(params, inputs), make_backend(params.backend, threads),
                    producer=("fem-twin", VERSION))

@@ -27,7 +27,7 @@ from stickslip import formats, h5io
 from stickslip.figures.style import plt, save_figure
 from stickslip.formats.analysis_file import write_analysis_file
 from stickslip.formats.event_table import read_slip_events, slip_events_table
-from stickslip.params import param
+from stickslip.plugin_params import param
 from stickslip.registry import register
 
 formats.register_format(formats.Format("toy-block", 1, __name__,
@@ -58,7 +58,7 @@ class BlockParams:
 
     def check(self):
         """The block must be able to stick after a slip: F_d below every threshold."""
-        from stickslip.params import ParameterError
+        from stickslip.plugin_params import ParameterError
 
         if self.F_d >= self.F_s * (1 - self.disorder):
             raise ParameterError("parameter 'F_d': must be below F_s (1 - disorder)")

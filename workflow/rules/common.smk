@@ -1,5 +1,5 @@
 # The study: the config validated (each plugin section against its plugin's JSON-Schema, defaults
-# filled) and expanded into jobs by stickslip.study before any rule is defined.
+# filled) and expanded into jobs by stickslip.study_plan before any rule is defined.
 
 import re
 import tempfile
@@ -9,10 +9,10 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from stickslip.params import ParameterError, did_you_mean
+from stickslip.plugin_params import ParameterError, did_you_mean
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
-from stickslip.study import Study, check_sweeps, normalise, plugin_sections
+from stickslip.study_plan import Study, check_sweeps, normalise, plugin_sections
 
 
 def _validate(section, schema, key):
@@ -89,14 +89,13 @@ def with_gpu_rule_resources(name):
 
 
 onstart:
-    # A local run with jobs on a GPU (fem, backend cuda) checks, before any job, that this machine can run them.
+    # A local run with jobs on a GPU (a solver's device_batch picks them) checks, before any job, that this machine
+    # can run them.
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "local":
         gpu_jobs = [job for job in workflow.dag.needrun_jobs() if job.resources.get("gpu")]
         if gpu_jobs:
-            from stickslip.fem.backends import make_backend
-
             try:
-                make_backend("cuda")
+                STUDY.check_device_runs()
             except ParameterError as error:
                 raise WorkflowError(f"{len(gpu_jobs)} job(s) run on a GPU ({gpu_jobs[0].rule.name}, ...): "
                                     f"{error}") from None

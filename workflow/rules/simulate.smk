@@ -1,7 +1,7 @@
 # One rule for every solver: the solver is a wildcard (a path component), chosen in the config. The job
 # receives its upstream files (the mesh) with their lineage (params.inputs). A run on a GPU (fem, backend cuda)
 # is made by rule simulate_gpu, the same rule asking for a GPU; runs of a GPU batch (config gpu_batch,
-# stickslip.study.gpu_batches) by one job of their batch's rule, each to its usual file. Every job on a GPU
+# stickslip.study_plan.device_batches) by one job of their batch's rule, each to its usual file. Every job on a GPU
 # has the resources that a profile sets for simulate_gpu (GPU_RULE, common.smk: a GPU partition, profiles/slurm).
 
 

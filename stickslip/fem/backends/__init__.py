@@ -13,7 +13,7 @@ run file and its id). A new backend: one module and :func:`register_backend` (do
 import os
 from importlib.metadata import PackageNotFoundError, version
 
-from ...params import ParameterError
+from ...plugin_params import ParameterError
 from .base import CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend
 from .cpu import AssembledBackend, StructuredBackend
 from .cuda import CudaBackend
@@ -115,7 +115,7 @@ def make_backend(name=DEFAULT_BACKEND, threads=1):
 
     Raises
     ------
-    stickslip.params.ParameterError
+    stickslip.plugin_params.ParameterError
         If no backend of that name is registered, or it cannot run on this machine (the message says why), or
         ``cuda`` would run on numba's CUDA simulator outside the tests (and :data:`SIMULATOR_VARIABLE` is not 1).
     """

@@ -7,7 +7,7 @@ drive targets and the clock. The rest of the package reads and changes that stat
 the methods below, each a point where a device backend synchronises with the host
 (FrictionQPotFEM's ``setU`` -> ``updated_u``): a change of displacement, drive or yield strains
 re-evaluates everything that follows from it before the call returns. The CPU backends hand out
-views and change their arrays in place (nothing is copied); a device backend copies what
+read-only views and change their arrays in place (nothing is copied); a device backend copies what
 :meth:`Backend.read` asks for and nothing else, and runs whole minimisations on the device.
 
 State fields (:data:`FIELDS`): ``u``, ``v``, ``a`` float64 [ndof] (displacement [length],
@@ -82,8 +82,8 @@ class Backend(abc.ABC):
     def read(self, *fields):
         """The state fields ``fields`` (:data:`FIELDS`), as a tuple of arrays.
 
-        CPU backends return views of the state (read only for the caller: change the state through
-        the methods below); a device backend returns host copies.
+        CPU backends return read-only views of the state (change it through the methods below); a
+        device backend returns host copies.
         """
 
     @abc.abstractmethod

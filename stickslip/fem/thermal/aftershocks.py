@@ -87,7 +87,7 @@ def aftershock_trial(simulation, state, hold_time, replica, control=None, max_ev
     s, p = simulation, simulation.params
     s.stack.restore(*state)
     observer = Observer(s)
-    protocol = thermal_protocol(s.stack, s.loading, s.relaxation, p, s.mesh, s.constants,
+    protocol = thermal_protocol(s.stack, s.model, s.loading, s.relaxation, p, s.mesh, s.constants,
                                 stream=STREAM + REPLICAS * (replica + 1))
     if control is not None:
         _unload_to(s, protocol, observer, *control)

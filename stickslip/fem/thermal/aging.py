@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import SolverError
 from .barriers import FORWARD
-from .junctions import STATE_FIELDS
+from .junctions import STATE_FIELDS, Junctions
 from .protocol import COLUMNS, STREAM, ThermalProtocol
 from .redraws import REDRAW, sample_with_redraws
 from .sampler import HOP, NONE, THRESHOLD
@@ -54,22 +54,39 @@ class JunctionChange:
 
     def moves(self):
         """:meth:`apply`, and whether a Gauss point changed well (its stress changed: the stack must relax)."""
-        before = self.stack.backend.read("idx")[0].copy()
+        token = self.stack.watch()
         self.apply()
-        return not np.array_equal(before, self.stack.backend.read("idx")[0])
+        return self.stack.moved(token)
 
 
 class AgingProtocol(ThermalProtocol):
-    """The thermal protocol with junction aging (module docstring); parameters as :class:`.protocol.ThermalProtocol`."""
+    """The thermal protocol with junction aging (module docstring); parameters as :class:`.protocol.ThermalProtocol`.
 
-    def __init__(self, stack, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
-        super().__init__(stack, loading, relaxation, params, mesh, constants, table, stream)
+    Its junctions (:class:`.junctions.Junctions`) are registered with the stack as the modifier of its yield strains
+    (:meth:`..stack.Stack.modify_yield_strains`): a stored state includes them. A protocol made for a stack whose
+    junctions are registered already (a hold trial, an aftershock replay on a run's stack) takes those over.
+
+    Attributes
+    ----------
+    junctions : stickslip.fem.thermal.junctions.Junctions
+    """
+
+    def __init__(self, stack, model, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
+        super().__init__(stack, model, loading, relaxation, params, mesh, constants, table, stream)
         p = params
+        blocks = model.epsy.shape[0]
+        self.junctions = stack.modifier
+        if self.junctions is None:
+            self.junctions = Junctions(blocks, p.junction_strengthening, p.junction_glass_temperature,
+                                       p.junction_attempt_rate, p.eps0)
+            stack.modify_yield_strains(self.junctions)
+        elif not isinstance(self.junctions, Junctions):
+            raise ValueError(f"the stack's yield strains are modified by {self.junctions!r}, not by junctions")
         self.columns = {**COLUMNS, **AGING_COLUMNS}
         self.header = {**self.header, "junction_strengthening": p.junction_strengthening,
                        "junction_glass_temperature": p.junction_glass_temperature,
                        "junction_attempt_rate": p.junction_attempt_rate}
-        self.state_fields = {name: ((stack.model.epsy.shape[0],), dtype) for name, dtype in STATE_FIELDS.items()}
+        self.state_fields = {name: ((blocks,), dtype) for name, dtype in STATE_FIELDS.items()}
         self.redraw = None
         if table is None:
             self.renew(p.margin, 0)  # the junctions of a new state (a restored one keeps its own)
@@ -100,23 +117,19 @@ class AgingProtocol(ThermalProtocol):
         """
         stack, t = self.stack, self.stack.time
         stream = self._stream(increment)
-        while stack.junctions.renew(stack.well_index(), *stream):
+        while self.junctions.renew(stack.well_index(), *stream):
             change = JunctionChange(stack)
             if not change.moves():
                 return
-            niter, _ = self.perturb_and_relax(change, margin)
-            if niter and stack.extend:
-                stack.hold_wells_ahead()
+            self.perturb_and_relax(change, margin)
             stack.set_time(t)
 
     def _redrawn(self, margin):
         """The event of a pending redraw: the junction set to its new depth, the stack relaxed."""
         stack, (block, depth) = self.stack, self.redraw
         t = stack.time
-        stack.junctions.depth[block] = depth
-        niter, _ = self.perturb_and_relax(JunctionChange(stack), margin)
-        if niter and stack.extend:
-            stack.hold_wells_ahead()
+        self.junctions.depth[block] = depth
+        self.perturb_and_relax(JunctionChange(stack), margin)
         stack.set_time(t)
         self.redraw, self.pending = None, None
         return {"yield_element": False, "hop_block": -1, "hop_direction": 0, "failed_hops": 0, "held": 0.0,
@@ -128,28 +141,27 @@ class AgingProtocol(ThermalProtocol):
         The yield strains go first: the load re-evaluates every Gauss point's well at the new offset,
         where the sampling found each of them in its well.
         """
-        before = self.stack.backend.read("idx")[0].copy()
+        token = self.stack.watch()
         if redraws:
             self.stack.push_yield_strains()
         if ds != 0.0:
             self.loading.load(ds)
-        if not np.array_equal(before, self.stack.backend.read("idx")[0]):
+        if self.stack.moved(token):
             raise SolverError(f"the load to the next event (drive offset {ds:.6e}, {redraws} junctions redrawn "
                               "meanwhile) moved a Gauss point out of its well (round-off at a yield strain)")
 
     def _load(self, margin, increment):
-        stack, junctions, wells = self.stack, self.stack.junctions, self.stack.wells
+        stack, model, junctions, wells = self.stack, self.model, self.junctions, self.stack.wells
         stream = self._stream(increment)
-        allowed = np.ones((stack.model.epsy.shape[0], 2), dtype=bool)
+        allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
         held, failed, redraws = 0.0, 0, 0
         while True:
             t = stack.time
             holding, until = self.schedule.stretch(t)
             speed = 0.0 if holding else self.speed
-            model = stack.model
-            idx, eps = stack.backend.read("idx", "eps")
+            idx, eps = stack.read("idx", "eps")
             kind, block, direction, dt, ds, count, depth = sample_with_redraws(
-                model.law, model.epsy.copy(), wells.epsy, wells.offset, junctions.well, junctions.depth,
+                model.law, stack.yield_strains.copy(), wells.epsy, wells.offset, junctions.well, junctions.depth,
                 junctions.scale, junctions.glass_temperature, junctions.attempt_rate, 1.0 / self.params.temperature,
                 idx, eps, self.loading.response.delta_eps, model.iface_dV, allowed, self.beta,
                 self.params.attempt_rate, speed, until - t, *stream)
@@ -184,10 +196,11 @@ class AgingProtocol(ThermalProtocol):
             stack.restore(*loaded)
 
 
-def thermal_protocol(stack, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
-    """The protocol of a thermal run: :class:`AgingProtocol` if its stack has junctions, else :class:`.protocol.ThermalProtocol`.
+def thermal_protocol(stack, model, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
+    """The protocol of a thermal run: :class:`AgingProtocol` if ``junction_strengthening > 0``, else
+    :class:`.protocol.ThermalProtocol`.
 
     Parameters as :class:`.protocol.ThermalProtocol`.
     """
-    cls = ThermalProtocol if stack.junctions is None else AgingProtocol
-    return cls(stack, loading, relaxation, params, mesh, constants, table, stream)
+    cls = AgingProtocol if params.junction_strengthening > 0.0 else ThermalProtocol
+    return cls(stack, model, loading, relaxation, params, mesh, constants, table, stream)

@@ -36,10 +36,11 @@ REPLICAS = 2**40
 
 
 def _barriers(simulation, unit):
-    model = simulation.stack.model
-    idx, eps = simulation.stack.backend.read("idx", "eps")
+    model, stack = simulation.model, simulation.stack
+    idx, eps = stack.read("idx", "eps")
     out = np.empty((model.epsy.shape[0], 2))
-    block_barriers(model.law, model.epsy, idx, eps, simulation.loading.response.delta_eps, model.iface_dV, 0.0, out)
+    block_barriers(model.law, stack.yield_strains, idx, eps, simulation.loading.response.delta_eps, model.iface_dV, 0.0,
+                   out)
     return out[:, FORWARD] / unit
 
 
@@ -50,7 +51,7 @@ def _slips(observer):
 
 def _junctions(stack, a, N):
     """Mean depth [G eps0^2 h^2], mean widening [eps0] and capped share of the junctions of interface ``a`` (NaN: none)."""
-    junctions = stack.junctions
+    junctions = stack.modifier  # an aging run's junctions (:class:`.aging.AgingProtocol`); None without aging
     mine = slice((a - 1) * N, a * N)
     if junctions is None or not np.any(junctions.well[mine] >= 0):
         return [np.nan] * 3
@@ -97,7 +98,7 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
     ds_c = s.loading.step_size(False)
     s.loading.load(max(ds_c - below / drive_scale(s.loading.response, p.eps0, s.mesh), 0.0))
     observer = Observer(s)
-    protocol = thermal_protocol(s.stack, s.loading, s.relaxation, p, s.mesh, s.constants,
+    protocol = thermal_protocol(s.stack, s.model, s.loading, s.relaxation, p, s.mesh, s.constants,
                                 stream=STREAM + REPLICAS * (replica + 1))
     unit = protocol.energy_unit * p.temperature
     t0 = s.stack.time

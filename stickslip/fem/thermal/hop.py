@@ -107,6 +107,8 @@ class ShearHop:
     ----------
     stack : stickslip.fem.stack.Stack
         At rest.
+    model : stickslip.fem.model.Model
+        The stack's model (its interface elements).
     modes : numpy.ndarray
         [ni, 8] :func:`shear_modes`.
     block : int
@@ -117,8 +119,9 @@ class ShearHop:
         Strain beyond the edge that every Gauss point of the block reaches (the kick's ``deps / 2``).
     """
 
-    def __init__(self, stack, modes, block, direction, overshoot):
+    def __init__(self, stack, model, modes, block, direction, overshoot):
         self.stack = stack
+        self.model = model
         self.mode = modes[block]
         self.block = block
         self.direction = direction
@@ -126,9 +129,10 @@ class ShearHop:
 
     def step(self):
         """Amplitude ``s`` of the shear mode from the state now [length] (:func:`hop_step`; NaN: impossible)."""
-        model, b = self.stack.model, self.block
-        eps, idx = self.stack.backend.read("eps", "idx")
-        return hop_step(model.iface_dNdx[b], self.mode, eps[b], model.epsy[b], idx[b], self.direction, self.overshoot)
+        b = self.block
+        eps, idx = self.stack.read("eps", "idx")
+        return hop_step(self.model.iface_dNdx[b], self.mode, eps[b], self.stack.yield_strains[b], idx[b], self.direction,
+                        self.overshoot)
 
     def apply(self):
         """Shear the block over its edge.
@@ -141,7 +145,7 @@ class ShearHop:
         stack, b = self.stack, self.block
         step = self.step()
         start = stack.well_index()[b]
-        stack.backend.add_u(stack.model.iface_dofs[b], step * self.mode)
+        stack.add_u(self.model.iface_dofs[b], step * self.mode)
         sign = 1 if self.direction == FORWARD else -1
         if np.any(np.sign(stack.well_index()[b] - start) != sign):
             raise SolverError(f"hop of block {b}: the kick of {step:.6e} did not carry all its Gauss points "

@@ -18,9 +18,10 @@ Gauss point in the well is unchanged (to round-off): a junction raises the block
 Gauss points lie in different wells has no junction: a junction holds a whole block, and when part
 of a block slips its junction is gone.
 
-The junctions are part of the yield strains the backend holds (:meth:`..stack.Stack.push_yield_strains`):
-the window of the blocks' sequences (:class:`..yield_strains.HeldYieldStrains`) widened by this object,
-handed to the backend through its seam only. The state (the well of every junction, as a global
+The junctions are part of the yield strains the backend holds: the aging protocol registers them with the
+stack as its yield-strain modifier (:meth:`..stack.Stack.modify_yield_strains`), which widens the window of the
+blocks' sequences (:class:`..yield_strains.HeldYieldStrains`) by :meth:`Junctions.modify` whenever it gives the
+backend its yield strains. The state (the well of every junction, as a global
 index, and its depth) is stored with every increment (``junction_well``, ``junction_depth``).
 """
 
@@ -181,8 +182,9 @@ class Junctions:
         self.attempt_rate = float(attempt_rate)
         self.eps0 = float(eps0)
 
-    def aged(self, wells):
-        """The held yield strains widened by the junctions: a new float64 [ni, ny] array.
+    def modify(self, wells):
+        """The held yield strains widened by the junctions: a new float64 [ni, ny] array (the junctions as the stack's
+        yield-strain modifier, :meth:`...stack.Stack.modify_yield_strains`).
 
         Parameters
         ----------

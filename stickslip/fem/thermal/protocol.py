@@ -150,6 +150,8 @@ class ThermalProtocol(AthermalProtocol):
     ----------
     stack, loading, relaxation
         As :class:`..protocol.AthermalProtocol` (the stack at the last stored increment).
+    model : stickslip.fem.model.Model
+        The stack's model (its law and interface elements).
     params : FemParams
         With ``temperature > 0``.
     mesh : stickslip.mesh.LayeredMesh
@@ -164,9 +166,10 @@ class ThermalProtocol(AthermalProtocol):
 
     columns = COLUMNS
 
-    def __init__(self, stack, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
+    def __init__(self, stack, model, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
         super().__init__(stack, loading, relaxation)
         p = params
+        self.model = model
         self.params = p
         self.energy_unit = energy_unit(p, constants["h"])
         self.beta = 1.0 / (p.temperature * self.energy_unit)
@@ -216,15 +219,13 @@ class ThermalProtocol(AthermalProtocol):
             shear mode cannot carry it over (the state is then as before).
         """
         stack = self.stack
-        shear = ShearHop(stack, self.modes, block, direction, self.overshoot)
+        shear = ShearHop(stack, self.model, self.modes, block, direction, self.overshoot)
         if math.isnan(shear.step()):
             return False
         before = stack.stored()
-        index = stack.well_index()
-        niter, _ = self.perturb_and_relax(shear, margin)
-        if niter and stack.extend:
-            stack.hold_wells_ahead()
-        if np.array_equal(stack.well_index(), index):
+        token = stack.watch()
+        self.perturb_and_relax(shear, margin)
+        if not stack.moved(token):
             stack.restore(*before)
             return False
         return True
@@ -235,16 +236,16 @@ class ThermalProtocol(AthermalProtocol):
         t = start[3]
         stream = self._stream(increment)
         ds_c = self.loading.step_size(False)
-        allowed = np.ones((stack.model.epsy.shape[0], 2), dtype=bool)
+        model = self.model
+        allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
         ds, held, failed = 0.0, 0.0, 0
         while True:
             holding, until = self.schedule.stretch(t)
             speed = 0.0 if holding else self.speed
-            model = stack.model  # a failed hop may have moved the held wells
-            idx, eps = stack.backend.read("idx", "eps")
+            idx, eps = stack.read("idx", "eps")  # a failed hop may have moved the held wells: read them anew
             kind, block, direction, dt = sample_event(
-                model.law, model.epsy, idx, eps, self.loading.response.delta_eps, model.iface_dV, allowed, self.beta,
-                self.params.attempt_rate, ds, speed, until - t, ds_c, *stream)
+                model.law, stack.yield_strains, idx, eps, self.loading.response.delta_eps, model.iface_dV, allowed,
+                self.beta, self.params.attempt_rate, ds, speed, until - t, ds_c, *stream)
             if holding:
                 held += dt
             else:

@@ -6,7 +6,7 @@ A CPU backend is :class:`CpuBackend` with a plate operator (:mod:`.plates`): the
 number of parallel blocks), compiled by numba for the types of the law and of the operator.
 Threads split elements and DOFs into blocks that are computed exactly as serially, so the results
 do not depend on the number of threads. The state lives in host memory: :meth:`CpuBackend.read`
-returns views of it and every change is made in place.
+returns read-only views of it and every change is made in place, by its methods.
 """
 
 import copy
@@ -38,6 +38,13 @@ CpuWork = namedtuple("CpuWork", [
     "plates",   # the plate operator (a registered named tuple, :mod:`.plates`)
     "iface",    # InterfaceWork
 ])
+
+
+def _read_only(array):
+    """A view of ``array`` that cannot be written (the state changes only through the backend's methods)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 def parallel_blocks(threads):
@@ -98,7 +105,7 @@ class CpuBackend(Backend):
         compute_force(self.model, self.work, self.state, update_wells)
 
     def read(self, *fields):
-        return tuple(getattr(self.state, name) for name in fields)
+        return tuple(_read_only(getattr(self.state, name)) for name in fields)
 
     def set_state(self, u, target, lever_target, t):
         s = self.state

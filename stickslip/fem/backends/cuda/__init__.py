@@ -164,7 +164,7 @@ def run_ensemble(runs, groups=None):
     ----------
     runs : Sequence[callable]
         ``run(backend)`` makes one run with the backend it is given (e.g. a closure over
-        :func:`stickslip.fem.run.run_simulation` with its parameters and output file).
+        :func:`stickslip.fem.run.simulate_to_file` with its parameters and output file).
     groups : int, optional
         Blocks per realisation at most (default: spread over the device).
 

@@ -1,7 +1,7 @@
 """A study's results opened for reading: its results tree, its database and its config.
 
 A study (a workflow config) writes everything under ``results/{study}/`` in the workflow directory, where
-Snakemake ran (:mod:`stickslip.study`), its database at ``results/{study}/stickslip.sqlite``.
+Snakemake ran (:mod:`stickslip.study_plan`), its database at ``results/{study}/stickslip.sqlite``.
 :class:`StudyResults` finds that directory from any folder below it (:mod:`stickslip.workdir`), finds the
 study there from its name, its config file or its results tree, and queries the database with the functions
 of :mod:`stickslip.provenance.query` (read-only connections), which ``stickslip db`` runs too. Its tables are
@@ -15,12 +15,13 @@ from pathlib import Path
 
 import yaml
 
+from . import registry
 from .errors import RunNotFoundError, StudyNotFoundError
 from .h5io import FileFormatError
 from .provenance import query
 from .provenance.filters import EVENT_FILTERS, RUN_FILTERS, with_filters
 from .runs import open_run
-from .study import PATHS, RESULTS, study_name
+from .study_plan import PATHS, RESULTS, study_name
 from .workdir import ENVIRONMENT, find_workdir
 
 __all__ = ["StudyResults", "CONFIGS"]
@@ -44,8 +45,6 @@ def _read_config(path):
 
 def _plugin_units(frame):
     """Units of the ``params.<name>`` columns of a runs table: the units its plugins declare."""
-    from . import registry
-
     units = {}
     for kind, plugin in frame[["kind", "plugin"]].drop_duplicates().itertuples(index=False):
         try:
@@ -81,7 +80,7 @@ class StudyResults:
     workdir : stickslip.workdir.Workdir
         The workflow directory and how it was found.
     root : pathlib.Path
-        The results tree: ``sim/``, ``events/``, ``mesh/``, ``figures/``, ``logs/`` (:data:`stickslip.study.PATHS`).
+        The results tree: ``sim/``, ``events/``, ``mesh/``, ``figures/``, ``logs/`` (:data:`stickslip.study_plan.PATHS`).
     database : pathlib.Path
         ``root / "stickslip.sqlite"``.
     config_file : pathlib.Path or None
@@ -153,7 +152,7 @@ class StudyResults:
 
         Raises
         ------
-        stickslip.params.ParameterError
+        stickslip.plugin_params.ParameterError
             A ``ValueError`` naming a filter that does not exist or a value that does not fit it.
         """
         frame = query.runs(self.database, **filters)
@@ -180,7 +179,7 @@ class StudyResults:
 
         Raises
         ------
-        stickslip.params.ParameterError
+        stickslip.plugin_params.ParameterError
             A ``ValueError`` naming a filter that does not exist or a value that does not fit it.
         """
         return query.events(self.database, **filters)

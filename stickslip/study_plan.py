@@ -34,10 +34,10 @@ import json
 import re
 from pathlib import Path
 
-from . import registry
+from . import mesh, registry
 from .hashing import short_hash
 from .lineage import Artifact
-from .params import ParameterError, json_schema, params_to_dict, parse_params
+from .plugin_params import ParameterError, json_schema, params_to_dict, parse_params
 from .provenance.code import code_hash
 from .provenance.record import record_path
 
@@ -134,7 +134,8 @@ class SimulationJob:
 
 @dataclasses.dataclass(frozen=True)
 class SimulationBatch:
-    """Runs of one solver made by one job on a GPU (:data:`BATCHED_PARAMS` equal): their minimisations share launches.
+    """Runs of one solver made by one job on a device (its ``device_batch`` shared parameters equal): their
+    minimisations share the device's launches.
 
     Attributes
     ----------
@@ -149,31 +150,33 @@ class SimulationBatch:
     runs: tuple
 
 
-#: What runs of one GPU batch share (the device mesh, its operators, the law, the time step, the drive); they may
-#: differ in every other parameter (seed, drive stiffness, protocol, temperature, ...).
-BATCHED_PARAMS = ("N", "plates", "K", "G", "rho", "dt_scale", "drive", "lever_height", "interface_law", "law_params")
+def _batching(sim):
+    """The ``device_batch`` of a :class:`SimulationJob`'s solver (:class:`stickslip.registry.DeviceBatching` or None)."""
+    return registry.get("solver", registry.config_key(sim.solver)[0]).device_batch
 
 
-def runs_on_gpu(sim):
-    """Whether a :class:`SimulationJob` runs on a GPU (``fem`` with ``backend = cuda``)."""
-    return sim.solver == "fem" and sim.params.get("backend") == "cuda"
+def runs_on_device(sim):
+    """Whether a :class:`SimulationJob` runs on a device (a GPU): its solver's ``device_batch`` says so."""
+    batching = _batching(sim)
+    return batching is not None and batching.on_device(sim.params)
 
 
-def gpu_batches(simulations, size):
-    """The GPU batches of a study's runs (:class:`SimulationBatch`): ``fem`` runs with ``backend = cuda`` sharing
-    :data:`BATCHED_PARAMS`, in run-id order, at most ``size`` each; none if ``size`` < 2."""
+def device_batches(simulations, size):
+    """The device batches of a study's runs (:class:`SimulationBatch`): runs of one solver on a device that agree on
+    the parameters its ``device_batch`` shares, in run-id order, at most ``size`` each; none if ``size`` < 2."""
     if size < 2:
         return []
     groups = {}
-    for sim in filter(runs_on_gpu, simulations):
-        key = json.dumps([sim.params.get(name) for name in BATCHED_PARAMS], sort_keys=True)
+    for sim in filter(runs_on_device, simulations):
+        key = json.dumps([sim.solver] + [sim.params.get(name) for name in _batching(sim).shared], sort_keys=True)
         groups.setdefault(key, []).append(sim)
     batches = []
     for key in sorted(groups):
         runs = groups[key]
         for first in range(0, len(runs), size):
             members = tuple(runs[first:first + size])
-            batches.append(SimulationBatch("fem", "b" + short_hash([sim.run_id for sim in members]), members))
+            batches.append(SimulationBatch(members[0].solver, "b" + short_hash([sim.run_id for sim in members]),
+                                           members))
     return batches
 
 
@@ -268,7 +271,7 @@ def plugin_sections(config):
         ``(key, section, schema)``: ``key`` names the section in messages (e.g.
         ``solvers.lever[0].grid``); ``section`` is the mapping itself (a schema
         validator that fills defaults changes it in place); ``schema`` comes from
-        :func:`stickslip.params.json_schema` of the plugin's parameter class.
+        :func:`stickslip.plugin_params.json_schema` of the plugin's parameter class.
 
     Raises
     ------
@@ -332,8 +335,6 @@ def check_sweeps(config):
 
 def _mesh_for(params):
     """Return (mesh_id, mesh parameters) for a solver run: the solver's fields named as MeshParams fields."""
-    from . import mesh
-
     fields = {f.name for f in dataclasses.fields(mesh.MeshParams)}
     mesh_params = parse_params(mesh.MeshParams, {k: v for k, v in params.items() if k in fields}, owner="mesh")
     return mesh.mesh_id(mesh_params), params_to_dict(mesh_params)
@@ -382,7 +383,7 @@ class Study:
         self.threads = int(config.get("threads", 1))
         self.meshes = {}
         self.simulations = self._simulations(config.get("solvers") or {})
-        self.batches = gpu_batches(self.simulations, int(config.get("gpu_batch", 0)))
+        self.batches = device_batches(self.simulations, int(config.get("gpu_batch", 0)))
         self.analyses, self.analysis_jobs = self._analyses(config.get("analyses") or {})
         self.figures = self._figures(config.get("figures") or {})
 
@@ -493,11 +494,22 @@ class Study:
     def single_runs(self, on_gpu):
         """A regular expression of the run ids made one job each by rule ``simulate`` (``on_gpu`` False: every
         run not on a GPU) or ``simulate_gpu`` (True: the runs on a GPU that are in no GPU batch)."""
-        gpu = {sim.run_id for sim in self.simulations if runs_on_gpu(sim)}
+        gpu = {sim.run_id for sim in self.simulations if runs_on_device(sim)}
         if not on_gpu:  # a run id is 16 characters: the lookahead sees all of it (a `$` in it would see the path's end)
             return f"(?!({'|'.join(sorted(gpu))}))[0-9a-f]{{16}}" if gpu else "[0-9a-f]{16}"
         alone = sorted(gpu - {sim.run_id for batch in self.batches for sim in batch.runs})
         return f"({'|'.join(alone)})" if alone else "(?!)"
+
+    def check_device_runs(self):
+        """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot make the study's runs on a
+        device (e.g. no GPU): the solver's preflight of its first such run, per solver."""
+        first = {}
+        for sim in filter(runs_on_device, self.simulations):
+            first.setdefault(sim.solver, sim)
+        for solver, sim in first.items():
+            plugin = registry.get("solver", registry.config_key(solver)[0])
+            if plugin.preflight is not None:
+                plugin.preflight(parse_params(plugin.params, sim.params, owner=f"solver '{solver}'"))
 
     def simulation(self, solver, run_id):
         """Return the :class:`SimulationJob` with this solver and run id (KeyError if none)."""
@@ -539,9 +551,7 @@ class Study:
     def code(kind, name):
         """Return the code hash of a plugin (``kind`` "mesh" for the mesh writer)."""
         if kind == "mesh":
-            from .mesh import write_mesh
-
-            return code_hash(write_mesh.__module__)
+            return code_hash(mesh.write_mesh.__module__)
         return code_hash(registry.get(kind, registry.config_key(name)[0]).module)
 
     @staticmethod

@@ -1,0 +1,94 @@
+"""The stack is the only face of a run's state: nothing in the package reaches past it, and it hands out no way in.
+
+The backend that owns the state is private to :class:`stickslip.fem.stack.Stack` (and handed, prepared, to the
+:class:`stickslip.fem.simulation.Simulation` that composes a run, for backend-level tests and benchmarks); the model's
+static parts are passed to those who need them; the yield strains the backend holds now are the stack's
+(:attr:`~stickslip.fem.stack.Stack.yield_strains`); junction aging is a yield-strain modifier that its protocol
+registers, so the stack imports nothing of the protocols.
+"""
+
+import ast
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stickslip.fem.backends import make_backend
+from stickslip.fem.parameters import FemParams
+from stickslip.fem.simulation import Simulation
+from stickslip.mesh import MeshParams, build_stack_mesh
+
+PACKAGE = Path(__file__).resolve().parents[1] / "stickslip"
+
+#: What reaches past the stack: its backend or model, the simulation's backend, the stack's private names.
+REACH_THROUGH = re.compile(r"\bstack\.(backend|model|_\w+)\b|\bsimulation\.backend\b|\bs\.backend\b|\._backend\b")
+
+#: The modules that may name the backend: the stack, its window of yield strains and the composition of a run.
+CORE = {"fem/stack.py", "fem/window.py", "fem/simulation.py"}
+
+
+def test_no_module_of_the_package_reaches_past_the_stack():
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = path.relative_to(PACKAGE).as_posix()
+        if name in CORE:
+            continue
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            if REACH_THROUGH.search(line):
+                found.append(f"{name}:{number}: {line.strip()}")
+    assert not found, "\n".join(found)
+
+
+def test_the_stack_imports_nothing_of_the_protocols():
+    tree = ast.parse((PACKAGE / "fem" / "stack.py").read_text())
+    imported = [node.module or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)]
+    imported += [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names]
+    assert not [m for m in imported if "thermal" in m or "protocol" in m], imported
+
+
+def test_the_grep_finds_a_reach_through():
+    assert REACH_THROUGH.search("idx = self.stack.backend.read('idx')")
+    assert REACH_THROUGH.search("law = sim.stack.model.law")
+    assert REACH_THROUGH.search("stack._modifier.depth[0] = 1")
+    assert not REACH_THROUGH.search("idx = self.stack.read('idx')")
+
+
+@pytest.fixture(scope="module")
+def aging():
+    params = FemParams(N=9, plates=2, relaxation="exact", temperature=1e-3, drive_rate=2e-8, junction_strengthening=5.0)
+    return Simulation(params, build_stack_mesh(MeshParams(N=9, plates=2)), make_backend())
+
+
+def test_what_the_stack_hands_out_cannot_change_the_state(aging):
+    stack = aging.stack
+    for name in ("u", "idx", "eps", "t"):
+        (array,) = stack.read(name)
+        with pytest.raises(ValueError, match="read-only"):
+            array[...] = 0
+    with pytest.raises(ValueError, match="read-only"):
+        stack.yield_strains[0, 0] = 0.0
+
+
+def test_watch_and_moved_tell_a_change_of_well(aging):
+    stack = aging.stack
+    before = stack.stored()
+    token = stack.watch()
+    aging.loading.step(False)
+    assert not stack.moved(token) and not stack.well_changes(token).any()
+    aging.loading.step(True)
+    assert stack.moved(token)
+    changes = stack.well_changes(token)
+    assert changes.max() >= 1 and np.array_equal(changes, stack.well_index() - token)
+    stack.restore(*before)
+    assert not stack.moved(token)
+
+
+def test_the_aging_protocol_registers_its_junctions_and_a_stored_state_holds_them(aging):
+    stack, junctions = aging.stack, aging.protocol.junctions
+    assert stack.modifier is junctions
+    state = stack.stored()
+    assert set(state[4]) == {"junction_depth", "junction_well"}
+    assert np.array_equal(stack.yield_strains, junctions.modify(stack.wells))  # the widened window is held
+    with pytest.raises(ValueError, match="modified by"):
+        stack.modify_yield_strains(junctions)
