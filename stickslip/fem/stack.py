@@ -12,6 +12,7 @@ the protocols.
 
 import numpy as np
 
+from .backends.base import read_only
 from .errors import SolverError
 from .laws import make_law
 from .model import build_model
@@ -19,13 +20,6 @@ from .window import HeldWindow
 from .yield_strains import HeldYieldStrains, interface_initstate
 
 __all__ = ["Stack", "stack_model"]
-
-
-def _read_only(array):
-    """A view of ``array`` that cannot be written."""
-    view = array.view()
-    view.flags.writeable = False
-    return view
 
 
 class Stack:
@@ -78,7 +72,7 @@ class Stack:
     def yield_strains(self):
         """The yield strains the backend holds now: the windows, modified (if a modifier is registered), float64
         [ni, ny], read only (they change when the windows move)."""
-        return _read_only(self._backend.model.epsy)
+        return read_only(self._backend.model.epsy)
 
     def well_index(self):
         """Global well index of every interface Gauss point (counted from the start of the sequence), int64 [ni, 4]."""

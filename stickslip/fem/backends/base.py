@@ -23,7 +23,7 @@ Statuses of :meth:`Backend.minimise`: :data:`CONVERGED`, :data:`MARGIN`, :data:`
 
 import abc
 
-__all__ = ["Backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED"]
+__all__ = ["Backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED", "read_only"]
 
 #: The state fields a backend holds (module docstring).
 FIELDS = ("u", "v", "a", "f", "idx", "eps", "sig", "target", "ubar", "lever", "t")
@@ -36,6 +36,13 @@ MARGIN = 0
 QUIET = 2
 #: Status of a minimisation: ``max_iter`` steps did not converge.
 MAX_ITER_REACHED = -1
+
+
+def read_only(array):
+    """A view of ``array`` that cannot be written (what a CPU backend's :meth:`Backend.read` hands out)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 class Backend(abc.ABC):

@@ -14,7 +14,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..base import Backend
+from ..base import Backend, read_only
 from .dynamics import residual, time_steps
 from .forces import compute_force, wells_hold
 from .interface_elements import NIN, NOUT, interface_layout
@@ -38,13 +38,6 @@ CpuWork = namedtuple("CpuWork", [
     "plates",   # the plate operator (a registered named tuple, :mod:`.plates`)
     "iface",    # InterfaceWork
 ])
-
-
-def _read_only(array):
-    """A view of ``array`` that cannot be written (the state changes only through the backend's methods)."""
-    view = array.view()
-    view.flags.writeable = False
-    return view
 
 
 def parallel_blocks(threads):
@@ -105,7 +98,7 @@ class CpuBackend(Backend):
         compute_force(self.model, self.work, self.state, update_wells)
 
     def read(self, *fields):
-        return tuple(_read_only(getattr(self.state, name)) for name in fields)
+        return tuple(read_only(getattr(self.state, name)) for name in fields)
 
     def set_state(self, u, target, lever_target, t):
         s = self.state
