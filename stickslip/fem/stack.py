@@ -58,11 +58,8 @@ class Stack:
         return self._window.modifier
 
     def keep_time(self, clock):
-        """Let a protocol's clock (:class:`.clock.Clock`) keep the stack's time from now, set to the stack's time.
-
-        The stack's :attr:`time`, its stored states and :meth:`restore` are then the clock's; the relaxations no
-        longer advance it (the backend goes on counting the time of its dynamics).
-        """
+        """Let a protocol's :class:`.clock.Clock`, set to the time now, keep the stack's time (:attr:`time`, the stored
+        states' and :meth:`restore`'s); the relaxations no longer advance it (the backend's dynamics go on counting)."""
         clock.restore(self.time)
         self._clock = clock
 
@@ -73,10 +70,8 @@ class Stack:
 
     @property
     def time(self):
-        """The stack's time [time]: the registered clock's, else the backend's."""
-        if self._clock is not None:
-            return self._clock.time
-        return float(self._backend.read("t")[0][0])
+        """The stack's time [time]: the kept clock's, else the time of the backend's dynamics."""
+        return self._clock.time if self._clock is not None else float(self._backend.read("t")[0][0])
 
     def read(self, *fields):
         """The state fields ``fields`` (:data:`.backends.base.FIELDS`), a tuple of read-only arrays."""
@@ -150,18 +145,8 @@ class Stack:
     def relax(self, relaxation, margin, record=False):
         """Bring the stack to rest with ``relaxation``; with ``extend``, then hold the wells ahead.
 
-        Parameters
-        ----------
-        relaxation : stickslip.fem.relaxation.DynamicRelaxation or stickslip.fem.relaxation.ExactRelaxation
-        margin, record
-            As :meth:`.relaxation.DynamicRelaxation.relax`.
-
-        Returns
-        -------
-        niter : int
-            Time steps made (0: stopped by the margin).
-        events : numpy.ndarray
-            float64 [nevent, 3] (element, time, direction) if ``record``.
+        Parameters and returns (``niter``, 0 if stopped by the margin; ``events``) as
+        :meth:`.relaxation.DynamicRelaxation.relax`; ``relaxation`` a ``DynamicRelaxation`` or ``ExactRelaxation``.
         """
         niter, events = relaxation.relax(self._backend, margin, record)
         if niter and self.extend:
