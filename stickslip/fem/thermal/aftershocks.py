@@ -48,9 +48,9 @@ def _unload_to(simulation, protocol, observer, a, stress):
     slope = (_stress(observer, a) - now) / probe
     stack.restore(*start)
     step = min((stress - now) / slope, 0.0) if slope > 0 else 0.0
-    wells = stack.well_index()
+    token = stack.watch()
     s.loading.load(step)
-    if not np.array_equal(wells, stack.well_index()):
+    if stack.moved(token):
         stack.restore(*start)
         protocol.perturb_and_relax(_Unload(s.loading, step), s.params.margin)
         protocol.after_event(s.params.margin, 0)
