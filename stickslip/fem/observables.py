@@ -115,7 +115,7 @@ class Observer:
         dict[str, float]
             Keys :func:`observable_columns`.
         """
-        u, sig, target, ubar, lever, t = self.stack.read("u", "sig", "target", "ubar", "lever", "t")
+        u, sig, target, ubar, lever = self.stack.read("u", "sig", "target", "ubar", "lever")
         p = self.params
         model = self.model
         eps0, sig0 = p.eps0, self.sig0
@@ -125,7 +125,7 @@ class Observer:
             sig_sum[layer] = elastic_stress(*eps_sum[layer], p.K, p.G)
         iface_sig = (sig * model.iface_dV[:, :, None]).reshape(self.n_interfaces, -1, 3).sum(axis=1)
         sig_sum[self.plastic] = iface_sig
-        row = {"t": float(t[0])}
+        row = {"t": self.stack.time}
         target_top = target[-1]
         row["gamma"] = (90.0 - math.degrees(math.atan2(self.top_height, target_top))) / self.gamma0
         total_eps = eps_sum.sum(axis=0) / self.volume.sum()

@@ -1,7 +1,20 @@
-"""The protocol of a run: what sequence of loads, kicks and relaxations makes its increments.
+"""The protocol of a run: one event-driven loop whose named hooks decide which perturbation comes next.
 
 A protocol drives a stack (:class:`.stack.Stack`) one stored increment at a time for the increment
-loop of :mod:`.run`. Its interface:
+loop of :mod:`.run`; increments alternate, a load then an event, as in the paper. :class:`EventLoop`
+is that loop, once for every protocol; a protocol overrides its hooks, not the loop (as FrictionQPotFEM's
+thermal class does):
+
+``next_event(margin, increment)``
+    brings the stack to the next event (a load increment) and remembers it as ``pending``; returns the
+    increment's columns, or None if the run must stop at the margin;
+``perform(pending, margin)``
+    performs that event (the event increment): a perturbation, then the relaxation
+    (:meth:`EventLoop.perturb_and_relax`); returns the increment's columns, or None at the margin;
+``after_event(margin, increment)``
+    what follows every event (junction aging renews the junctions).
+
+Its other interface, for the increment loop:
 
 ``columns``
     dict name -> numpy dtype of the columns it adds to the increment table;
@@ -9,37 +22,43 @@ loop of :mod:`.run`. Its interface:
     dict of the root attributes it adds to the run file;
 ``state_fields``
     dict name -> (shape, dtype) of further state it stores per increment beside the stack's
-    displacement, drive and clock (the fifth item of :meth:`.stack.Stack.stored`, e.g. the junctions);
+    displacement, drive and time (the fifth item of :meth:`.stack.Stack.stored`, e.g. the junctions);
 ``initial_row()``
     its columns for increment 0;
 ``step(event, margin, increment)``
-    makes the next increment (number ``increment``), a load (``event`` False) or an event (True), and returns its
-    columns with ``yield_element``, or None if the run must stop at the margin;
+    the loop: the next increment (number ``increment``), a load (``event`` False) or an event (True), its
+    columns with ``yield_element``;
 ``stored(row)``
     is told the row just appended (e.g. to start a hold after a slip).
 
-:class:`AthermalProtocol` is the paper's event-driven quasistatic protocol; its
-:meth:`AthermalProtocol.perturb_and_relax` serves any perturbation (its own kick, a thermal hop);
-:class:`.thermal.ThermalProtocol` (``temperature > 0``) overrides the steps and keeps the rest.
+:class:`AthermalProtocol` is the paper's: the athermal threshold is the only source of events and the event
+is the kick. :class:`.thermal.ThermalProtocol` (``temperature > 0``) draws its events from composed event
+sources (:mod:`.thermal.sources`) and keeps the physical time (:mod:`.clock`).
 """
 
 import numpy as np
 
 from .loading import KickAlongResponse
 
-__all__ = ["AthermalProtocol"]
+__all__ = ["EventLoop", "AthermalProtocol"]
 
 
-class AthermalProtocol:
-    """The paper's protocol: elastic load steps to the brink of yielding alternate with kicks and relaxations.
+class EventLoop:
+    """The event-driven loop of every protocol (module docstring): a load to the next event, then that event.
 
     Parameters
     ----------
     stack : stickslip.fem.stack.Stack
     loading : stickslip.fem.loading.Loading
         Steps along the stack's linear response.
-    relaxation : stickslip.fem.relaxation.DynamicRelaxation
-        How a kicked stack comes to rest.
+    relaxation : stickslip.fem.relaxation.DynamicRelaxation or stickslip.fem.relaxation.ExactRelaxation
+        How a perturbed stack comes to rest.
+
+    Attributes
+    ----------
+    pending : object or None
+        The event a load increment ended at, what :meth:`perform` is given next (None: none, or the athermal
+        protocol's, whose event is always the kick).
     """
 
     columns = {}
@@ -50,6 +69,7 @@ class AthermalProtocol:
         self.stack = stack
         self.loading = loading
         self.relaxation = relaxation
+        self.pending = None
 
     @staticmethod
     def initial_row():
@@ -57,17 +77,29 @@ class AthermalProtocol:
         return {}
 
     def step(self, event, margin, increment):
-        """Load to the brink (:meth:`.loading.Loading.step`) or kick and relax (:meth:`kick`)."""
-        if event:
-            converged, yield_element = self.kick(margin)
-            return {"yield_element": yield_element} if converged else None
-        self.loading.step(False)
-        if not self.stack.extend and not self.stack.within_margin(margin):
-            return None
-        return {"yield_element": False}
+        """The next increment: :meth:`next_event` (a load), or :meth:`perform` the pending event and
+        :meth:`after_event` (an event)."""
+        if not event:
+            return self.next_event(margin, increment)
+        pending, self.pending = self.pending, None
+        row = self.perform(pending, margin)
+        if row is not None:
+            self.after_event(margin, increment)
+        return row
+
+    def next_event(self, margin, increment):
+        """Hook: bring the stack to the next event, set :attr:`pending`; the load increment's columns (None: stop)."""
+        raise NotImplementedError
+
+    def perform(self, pending, margin):
+        """Hook: perform the event ``pending``; the event increment's columns (None: stopped by the margin)."""
+        raise NotImplementedError
+
+    def after_event(self, margin, increment):
+        """Hook: what follows every event (nothing here)."""
 
     def stored(self, row):
-        """Nothing to remember."""
+        """Told the row just appended (nothing to remember here)."""
 
     def perturb_and_relax(self, perturbation, margin, record=False):
         """Perturb the stack and relax it; with ``extend``, redone until the held wells suffice.
@@ -141,3 +173,20 @@ class AthermalProtocol:
             stack.restore(*before)
             niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, True), margin)
         return niter != 0, fallback
+
+
+class AthermalProtocol(EventLoop):
+    """The paper's protocol: elastic load steps to the brink of yielding (the athermal threshold) alternate with
+    kicks and relaxations. Parameters as :class:`EventLoop`."""
+
+    def next_event(self, margin, increment):
+        """Load to the brink of yielding (:meth:`.loading.Loading.step`); None if a Gauss point is within ``margin``."""
+        self.loading.step(False)
+        if not self.stack.extend and not self.stack.within_margin(margin):
+            return None
+        return {"yield_element": False}
+
+    def perform(self, pending, margin):
+        """Kick and relax (:meth:`EventLoop.kick`); ``pending`` is None (the event is always the kick)."""
+        converged, yield_element = self.kick(margin)
+        return {"yield_element": yield_element} if converged else None

@@ -4,7 +4,7 @@ The replay is the ``fem`` solver's capability (:func:`stickslip.registry.registe
 ``replay=``): an analysis asks the solver that wrote a file to replay its events. The
 model is built once per run file; each replay restores the stored state before the kick
 and runs the same kick and relaxation as the run
-(:meth:`.protocol.AthermalProtocol.perturb_and_relax` with :class:`.loading.KickAlongResponse`).
+(:meth:`.protocol.EventLoop.perturb_and_relax` with :class:`.loading.KickAlongResponse`).
 For a thermal run it also holds a stored state at a load and reloads it
 (:meth:`EventReplay.hold`, :mod:`.thermal.holds`), or holds it at its load and records the events
 (:meth:`EventReplay.aftershocks`, :mod:`.thermal.aftershocks`), and for any run it gives the interface fields of
@@ -151,8 +151,8 @@ class EventReplay:
         s.stack.restore(*before)
         kick = KickAlongResponse(s.loading, bool(self._yield_element[increment]))
         niter, events = s.protocol.perturb_and_relax(kick, self.params.margin, record=True)
-        u, t = s.stack.read("u", "t")
-        if niter == 0 or not np.array_equal(u, after[0]) or t[0] != after[3]:
+        u, = s.stack.read("u")
+        if niter == 0 or not np.array_equal(u, after[0]) or s.stack.time != after[3]:
             raise AssertionError(f"{self.path}: replaying increment {increment} did not reproduce the stored state")
         element = events[:, 0].astype(np.int64)
         return pd.DataFrame({"a": element // self.N + 1, "block": element % self.N, "t": events[:, 1] - before[3],

@@ -60,7 +60,8 @@ class Simulation:
     stack : stickslip.fem.stack.Stack
     relaxation : stickslip.fem.relaxation.DynamicRelaxation
     loading : stickslip.fem.loading.Loading
-    protocol : stickslip.fem.protocol.AthermalProtocol
+    protocol : stickslip.fem.protocol.EventLoop
+        :class:`.protocol.AthermalProtocol` or a thermal protocol (:func:`.thermal.thermal_protocol`).
     """
 
     def __init__(self, params, mesh, backend, response=None, table=None):

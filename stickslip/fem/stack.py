@@ -6,8 +6,9 @@ blocks' unbounded sequences (:class:`.window.HeldWindow`): a well's global index
 the window's offset, and with ``yield_strains = extend`` the windows are moved ahead of the Gauss points
 after every relaxation that moved something (:meth:`Stack.relax`). What the backend holds may be modified
 by one **yield-strain modifier** that a protocol registers (:meth:`Stack.modify_yield_strains`; junction
-aging): a stored state then includes the modifier's state as a fifth item. The stack imports nothing of
-the protocols.
+aging): a stored state then includes the modifier's state as a fifth item. The stack's time is its backend's
+(the time steps of the dynamics) unless a protocol keeps its own clock (:meth:`Stack.keep_time`, a thermal
+run's: :mod:`.clock`). The stack imports nothing of the protocols.
 """
 
 import numpy as np
@@ -39,6 +40,7 @@ class Stack:
     def __init__(self, backend, wells, extend):
         self._backend = backend
         self._window = HeldWindow(backend, wells)
+        self._clock = None
         self.extend = extend
 
     @property
@@ -55,14 +57,21 @@ class Stack:
         """The registered yield-strain modifier (None: none)."""
         return self._window.modifier
 
+    def keep_time(self, clock):
+        """Let a protocol's :class:`.clock.Clock`, set to the time now, keep the stack's time (:attr:`time`, the stored
+        states' and :meth:`restore`'s); the relaxations no longer advance it (the backend's dynamics go on counting)."""
+        clock.restore(self.time)
+        self._clock = clock
+
+    @property
+    def clock(self):
+        """The protocol's clock that keeps the stack's time (None: the backend's time of the dynamics)."""
+        return self._clock
+
     @property
     def time(self):
-        """The clock [time]."""
-        return float(self._backend.read("t")[0][0])
-
-    def set_time(self, t):
-        """Set the clock [time]."""
-        self._backend.set_time(t)
+        """The stack's time [time]: the kept clock's, else the time of the backend's dynamics."""
+        return self._clock.time if self._clock is not None else float(self._backend.read("t")[0][0])
 
     def read(self, *fields):
         """The state fields ``fields`` (:data:`.backends.base.FIELDS`), a tuple of read-only arrays."""
@@ -97,8 +106,8 @@ class Stack:
     def stored(self):
         """Copies of what :meth:`restore` needs, the state stored per increment: (u, target, lever_target, t),
         and with a modifier its state (``stored()``) as a fifth item."""
-        u, target, lever, t = self._backend.read("u", "target", "lever", "t")
-        state = (u.copy(), target.copy(), float(lever[0]), float(t[0]))
+        u, target, lever = self._backend.read("u", "target", "lever")
+        state = (u.copy(), target.copy(), float(lever[0]), self.time)
         return state if self.modifier is None else (*state, self.modifier.stored())
 
     def restore(self, u, target, lever_target, t, modified=None):
@@ -116,6 +125,8 @@ class Stack:
             self.modifier.restore(modified)
             self._window.push()
         self._backend.set_state(u, target, lever_target, t)
+        if self._clock is not None:
+            self._clock.restore(t)
         if self.extend:
             self.hold_wells_ahead()
 
@@ -134,18 +145,8 @@ class Stack:
     def relax(self, relaxation, margin, record=False):
         """Bring the stack to rest with ``relaxation``; with ``extend``, then hold the wells ahead.
 
-        Parameters
-        ----------
-        relaxation : stickslip.fem.relaxation.DynamicRelaxation or stickslip.fem.relaxation.ExactRelaxation
-        margin, record
-            As :meth:`.relaxation.DynamicRelaxation.relax`.
-
-        Returns
-        -------
-        niter : int
-            Time steps made (0: stopped by the margin).
-        events : numpy.ndarray
-            float64 [nevent, 3] (element, time, direction) if ``record``.
+        Parameters and returns (``niter``, 0 if stopped by the margin; ``events``) as
+        :meth:`.relaxation.DynamicRelaxation.relax`; ``relaxation`` a ``DynamicRelaxation`` or ``ExactRelaxation``.
         """
         niter, events = relaxation.relax(self._backend, margin, record)
         if niter and self.extend:

@@ -3,7 +3,7 @@
 A backend is chosen per run (:func:`..backends.make_backend`) and prepared once for a model on its
 mesh (:meth:`Backend.prepare`); from then on it **owns the state** of the stack: displacement,
 velocity, acceleration, forces, the well of every interface Gauss point, the yield strains, the
-drive targets and the clock. The rest of the package reads and changes that state only through
+drive targets and the time of its dynamics. The rest of the package reads and changes that state only through
 the methods below, each a point where a device backend synchronises with the host
 (FrictionQPotFEM's ``setU`` -> ``updated_u``): a change of displacement, drive or yield strains
 re-evaluates everything that follows from it before the call returns. The CPU backends hand out
@@ -15,7 +15,8 @@ velocity, acceleration), ``f`` float64 [ndof] (internal force, material and driv
 ``idx`` int64 [ni, 4] (held well of every interface Gauss point), ``eps``, ``sig`` float64
 [ni, 4, 3] (interface strain and stress, ``xx, yy, xy``), ``target``, ``ubar`` float64 [nlayer]
 (drive target and volume-averaged x-displacement of every layer [length]), ``lever`` float64 [2]
-(free lever: drive target and lever position [length]), ``t`` float64 [1] (time).
+(free lever: drive target and lever position [length]), ``t`` float64 [1] (the time of the dynamics: set
+with the state, advanced by ``dt`` per time step; a thermal run's physical time is its protocol's, :mod:`..clock`).
 
 Statuses of :meth:`Backend.minimise`: :data:`CONVERGED`, :data:`MARGIN`, :data:`QUIET`,
 :data:`MAX_ITER_REACHED`.
@@ -100,10 +101,6 @@ class Backend(abc.ABC):
         ``v = a = 0``; every Gauss point moves to the well of its strain; forces evaluated (a free
         lever's layer targets follow from ``lever_target``).
         """
-
-    @abc.abstractmethod
-    def set_time(self, t):
-        """Set the clock ``t`` [time] (a protocol's own clock; time steps advance it by ``dt``)."""
 
     @abc.abstractmethod
     def set_load_direction(self, delta_u, delta_target, delta_lever):

@@ -1,7 +1,7 @@
 """Finite temperature: thermally activated hops of the interface blocks, with a finite drive rate.
 
 The protocol of a ``temperature > 0`` run (:class:`.protocol.ThermalProtocol`): kinetic Monte
-Carlo on top of the event-driven protocol. Every block hops over the barrier of its well
+Carlo on the event-driven loop, its events drawn by a composed event source (:mod:`.sources`). Every block hops over the barrier of its well
 (:mod:`.barriers`, from the law) at an Arrhenius rate; the next hop is drawn exactly from the
 time-dependent total rate while the drive advances (:mod:`.sampler`); a hop carries the block over
 its barrier (:mod:`.hop`) and the stack relaxes; the athermal threshold, if it comes first, is the usual
@@ -15,11 +15,13 @@ from .barriers import BACKWARD, FORWARD, barrier_bounds, block_barrier, block_ba
 from .hop import ShearHop, hop_step, shear_modes
 from .holds import hold_trial
 from .junctions import Junctions
-from .protocol import COLUMNS, HoldSchedule, ThermalProtocol, drive_scale, energy_unit
+from .protocol import COLUMNS, ThermalProtocol, drive_scale, energy_unit
 from .redraws import REDRAW, sample_with_redraws
 from .sampler import HOP, NONE, THRESHOLD, sample_event
+from .schedule import HoldSchedule
+from .sources import ArrheniusHops, ArrheniusWithRedraws
 
 __all__ = ["ThermalProtocol", "HoldSchedule", "COLUMNS", "drive_scale", "energy_unit", "FORWARD", "BACKWARD",
            "block_barrier", "block_barriers", "barrier_bounds", "sample_event", "NONE", "HOP", "THRESHOLD", "ShearHop",
            "hop_step", "shear_modes", "hold_trial", "AgingProtocol", "AGING_COLUMNS", "thermal_protocol", "Junctions",
-           "REDRAW", "sample_with_redraws"]
+           "REDRAW", "sample_with_redraws", "ArrheniusHops", "ArrheniusWithRedraws"]

@@ -14,7 +14,7 @@ no recent slip. Trials of the same replica draw the same random numbers.
 import numpy as np
 
 from ..observables import Observer
-from .aging import AgingProtocol, thermal_protocol
+from .aging import thermal_protocol
 from .holds import REPLICAS
 from .protocol import STREAM
 
@@ -48,15 +48,12 @@ def _unload_to(simulation, protocol, observer, a, stress):
     slope = (_stress(observer, a) - now) / probe
     stack.restore(*start)
     step = min((stress - now) / slope, 0.0) if slope > 0 else 0.0
-    wells = stack.well_index()
+    token = stack.watch()
     s.loading.load(step)
-    if not np.array_equal(wells, stack.well_index()):
+    if stack.moved(token):
         stack.restore(*start)
-        t = stack.time
         protocol.perturb_and_relax(_Unload(s.loading, step), s.params.margin)
-        stack.set_time(t)
-        if isinstance(protocol, AgingProtocol):
-            protocol.renew(s.params.margin, 0)
+        protocol.after_event(s.params.margin, 0)
 
 
 def aftershock_trial(simulation, state, hold_time, replica, control=None, max_events=MAX_HOLD_EVENTS):

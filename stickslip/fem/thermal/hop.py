@@ -6,7 +6,7 @@ upper nodes moved by ``+s/2`` in x, its lower nodes by ``-s/2``; a uniform simpl
 ``eps_xy = s / (2 h)`` of the block) is applied with the smallest ``|s|`` that carries every one
 of its four Gauss points a strain ``deps / 2`` past the edge (the athermal kick's overshoot). The
 thermal protocol then relaxes the stack as after a kick
-(:meth:`..protocol.AthermalProtocol.perturb_and_relax`: the relaxation of the run, an avalanche may
+(:meth:`..protocol.EventLoop.perturb_and_relax`: the relaxation of the run, an avalanche may
 follow), and restores the state before the hop if every well index came back (the block fell back
 into its well: the true barrier of the move is higher than the constant-load one).
 """

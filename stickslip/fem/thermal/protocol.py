@@ -2,25 +2,25 @@
 
 Increments alternate as in the athermal protocol, a load then an event:
 
-- **load** (odd increments): from the state at rest after the last event, time runs on: the
-  drive advances at ``drive_rate`` (or is held, see below) along the linear response, which moves
-  every Gauss point within its well, and the next event is drawn exactly
-  (:func:`.sampler.sample_event`): a thermally activated hop of a block, or the athermal threshold
-  if no hop comes first. The stored load increment is the state loaded to the time of that event
-  (for the threshold: the athermal load step to the brink, :meth:`..loading.Loading.step`).
-- **event** (even increments): the hop (:meth:`ThermalProtocol.hop`) or the athermal kick
-  (:meth:`..protocol.AthermalProtocol.kick`), with the relaxation of the run.
+- **load** (odd increments, :meth:`ThermalProtocol.next_event`): from the state at rest after the
+  last event, time runs on: the drive advances at ``drive_rate`` (or is held, see below) along the
+  linear response, which moves every Gauss point within its well, and the protocol's event source
+  (:mod:`.sources`) draws the next event exactly: a thermally activated hop of a block, or the athermal
+  threshold if no hop comes first (with junction aging, a redraw of a junction, :mod:`.aging`). The
+  stored load increment is the state loaded to the time of that event (for the threshold: the athermal
+  load step to the brink, :meth:`..loading.Loading.step`).
+- **event** (even increments, :meth:`ThermalProtocol.perform`): the hop (:meth:`ThermalProtocol.hop`)
+  or the athermal kick (:meth:`..protocol.EventLoop.kick`), with the relaxation of the run.
 
 A hop whose block falls back into its well restores the state, counts as failed (column
 ``failed_hops`` of the next load increment) and leaves that block and direction out of the
 rates until the next event; the draw goes on from the time of the failed hop. Avalanches take no
-time: the state's ``t`` is the thermal clock (the minimisation's time steps are not added), which
-assumes that the drive moves the state by much less than a well during an avalanche.
+time: the protocol keeps the physical time (its :class:`..clock.Clock`, registered with the stack; the
+minimisation's time steps are not added), which assumes that the drive moves the state by much less
+than a well during an avalanche.
 
-Slide-hold-slide (:class:`HoldSchedule`): once the drive has advanced by ``hold_delay`` since the
-last slip event (an event in which every block of some interface changed well), it stops for the
-next of ``hold_times`` (cycled) while time and hops go on; a slip during the hold ends it, a slip
-before it starts postpones it to the next cycle.
+Slide-hold-slide (:class:`.schedule.HoldSchedule`): once the drive has advanced by ``hold_delay`` since
+the last slip event, it stops for the next of ``hold_times`` (cycled) while time and hops go on.
 
 Columns added to the increment table (:data:`COLUMNS`): ``hop_block`` (interface element of the
 hop, -1 for an athermal kick), ``hop_direction`` (+1 forward, -1 backward, 0 athermal), both on the
@@ -35,17 +35,20 @@ gives the same bytes.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
+from ..clock import Clock
 from ..errors import SolverError
-from ..protocol import AthermalProtocol
+from ..protocol import EventLoop
 from ..random import pcg32_seed
 from .barriers import BACKWARD, FORWARD
 from .hop import ShearHop, shear_modes
-from .sampler import HOP, NONE, sample_event
+from .sampler import HOP, NONE, THRESHOLD
+from .schedule import HoldSchedule, replay_slips
 
-__all__ = ["ThermalProtocol", "HoldSchedule", "COLUMNS", "drive_scale", "energy_unit", "STREAM"]
+__all__ = ["ThermalProtocol", "Pending", "COLUMNS", "drive_scale", "energy_unit", "STREAM"]
 
 #: The increment table's thermal columns and their types.
 COLUMNS = {"hop_block": np.int64, "hop_direction": np.int64, "failed_hops": np.int64, "held": np.float64}
@@ -71,108 +74,71 @@ def drive_scale(response, eps0, mesh):
     return float(response.delta_target[-1] / (2.0 * eps0 * mesh.layer_mid_height[-1]))
 
 
-class HoldSchedule:
-    """When the drive is held: the slide-hold-slide protocol of the module docstring.
-
-    Parameters
-    ----------
-    hold_times : Sequence[float]
-        Hold durations, cycled [time]; empty: the drive never stops.
-    delay : float
-        Time of driving after a slip before the hold starts [time].
+class Pending(NamedTuple):
+    """The event a load increment ended at, which the next (event) increment performs.
 
     Attributes
     ----------
-    started : int
-        Holds started so far (the next one lasts ``hold_times[started % len(hold_times)]``).
+    kind : int
+        :data:`.sampler.THRESHOLD` (the athermal kick), ``HOP`` or :data:`.redraws.REDRAW`.
+    block : int
+        The hop's interface element, or the redrawn junction's block; -1 for the threshold.
+    sign : int
+        The hop's direction, +1 forward, -1 backward; 0 otherwise.
+    depth : float
+        A redraw's new junction depth [G eps0^2 h^2]; NaN otherwise.
+    after : tuple or None
+        A hop's stored state after its avalanche (None: redo the hop, a run resumed at its load increment).
     """
 
-    def __init__(self, hold_times, delay):
-        self.hold_times = tuple(hold_times)
-        self.delay = float(delay)
-        self.started = 0
-        self.start = self.end = math.inf
-
-    def hold_now(self, t, duration):
-        """Hold the drive from time ``t`` for ``duration`` (then drive on; no further holds)."""
-        self.hold_times = ()
-        self.start, self.end = t, t + duration
-
-    def slip(self, t):
-        """A slip at time ``t``: a hold that had started is over; the next one is scheduled."""
-        if t > self.start:
-            self.started += 1
-        if self.hold_times:
-            self.start = t + self.delay
-            self.end = self.start + self.hold_times[self.started % len(self.hold_times)]
-        else:
-            self.start = self.end = math.inf
-
-    def stretch(self, t):
-        """``(holding, until)``: whether the drive is held at time ``t``, and until when that lasts (``inf``: on)."""
-        if t < self.start:
-            return False, self.start
-        if t < self.end:
-            return True, self.end
-        return False, math.inf
+    kind: int
+    block: int = -1
+    sign: int = 0
+    depth: float = math.nan
+    after: tuple = None
 
 
-def _slips(table, N):
-    """Times of the stored slip events (event increments in which every block of an interface changed well)."""
-    kick = np.asarray(table["kick"], dtype=bool)
-    full = np.zeros(kick.size, dtype=bool)
-    for name in table:
-        if name.startswith("A_a"):
-            full |= np.asarray(table[name]) == N
-    return np.asarray(table["t"], dtype=np.float64)[kick & full]
-
-
-def _resumed(table, N, schedule):
-    """Replay the slips of a stored table into ``schedule``; return the hop pending after its last increment.
-
-    Returns
-    -------
-    tuple or None
-        ``(hop_block, hop_direction)`` of a last stored load increment (its event is next), else None.
-    """
-    table = {name: np.asarray(table[name]) for name in table}
-    for t in _slips(table, N):
-        schedule.slip(t)
-    if table["kick"][-1]:
-        return None
-    return int(table["hop_block"][-1]), int(table["hop_direction"][-1])
-
-
-class ThermalProtocol(AthermalProtocol):
-    """Thermally activated hops with a finite drive rate (module docstring): the athermal protocol with its own steps.
+class ThermalProtocol(EventLoop):
+    """Thermally activated events with a finite drive rate (module docstring): the event loop's hooks.
 
     Parameters
     ----------
     stack, loading, relaxation
-        As :class:`..protocol.AthermalProtocol` (the stack at the last stored increment).
+        As :class:`..protocol.EventLoop` (the stack at the last stored increment).
     model : stickslip.fem.model.Model
-        The stack's model (its law and interface elements).
+        The stack's model (its interface elements).
     params : FemParams
         With ``temperature > 0``.
     mesh : stickslip.mesh.LayeredMesh
     constants : dict
         :func:`..constants.derived_constants`.
+    source : stickslip.fem.thermal.sources.ArrheniusHops or stickslip.fem.thermal.sources.ArrheniusWithRedraws
+        Draws the next event (:func:`.aging.thermal_protocol` composes them).
     table : Mapping[str, numpy.ndarray], optional
         The stored increment table's columns (a resumed run), None for a new run.
     stream : int, optional
         ``initseq`` of the random stream of increment 0 (increment ``i`` draws from ``stream + i``);
         other values give independent replicas (:mod:`.holds`).
+
+    Attributes
+    ----------
+    clock : stickslip.fem.clock.Clock
+        The physical time, registered with the stack (a clock registered already is taken over).
+    schedule : stickslip.fem.thermal.schedule.HoldSchedule
     """
 
     columns = COLUMNS
 
-    def __init__(self, stack, model, loading, relaxation, params, mesh, constants, table=None, stream=STREAM):
+    def __init__(self, stack, model, loading, relaxation, params, mesh, constants, source, table=None,
+                 stream=STREAM):
         super().__init__(stack, loading, relaxation)
         p = params
-        self.model = model
-        self.params = p
+        self.model, self.params, self.source = model, p, source
+        self.clock = stack.clock
+        if self.clock is None:
+            self.clock = Clock(stack.time)
+            stack.keep_time(self.clock)
         self.energy_unit = energy_unit(p, constants["h"])
-        self.beta = 1.0 / (p.temperature * self.energy_unit)
         self.speed = p.drive_rate / drive_scale(loading.response, p.eps0, mesh)
         self.modes = shear_modes(mesh)
         self.overshoot = 0.5 * constants["deps"]
@@ -181,8 +147,11 @@ class ThermalProtocol(AthermalProtocol):
                        "energy_unit": self.energy_unit}
         self.stream = int(stream)
         self.schedule = HoldSchedule(p.hold_times, p.hold_delay / p.drive_rate)
-        self.pending = None if table is None else _resumed(table, p.N, self.schedule)
-        self._after = None
+        if table is not None:
+            replay_slips(table, p.N, self.schedule)
+            if not np.asarray(table["kick"])[-1]:  # resumed at a load increment: its event is next
+                block, sign = int(np.asarray(table["hop_block"])[-1]), int(np.asarray(table["hop_direction"])[-1])
+                self.pending = Pending(THRESHOLD) if block < 0 else Pending(HOP, block, sign)
 
     @staticmethod
     def initial_row():
@@ -190,15 +159,42 @@ class ThermalProtocol(AthermalProtocol):
         return {"hop_block": -1, "hop_direction": 0, "failed_hops": 0, "held": 0.0}
 
     def _stream(self, increment):
-        state, inc = pcg32_seed(np.array([self.params.seed], dtype=np.uint64),
-                                np.array([self.stream + increment], dtype=np.uint64))
-        return state, inc
+        return pcg32_seed(np.array([self.params.seed], dtype=np.uint64),
+                          np.array([self.stream + increment], dtype=np.uint64))
 
-    def step(self, event, margin, increment):
-        """The next increment: a load to the next event (``event`` False) or that event; see the module docstring."""
-        if event:
-            return self._event(margin)
-        return self._load(margin, increment)
+    def next_event(self, margin, increment):
+        """Let time run to the next event drawn by the source; the stack at it, the event :attr:`pending`.
+
+        A hop is tried at once (:meth:`hop`): one that falls back is undone, counted (``failed_hops``) and left out
+        of the draw with its direction until the next event, and the draw goes on from its time.
+        """
+        stream = self._stream(increment)
+        allowed = np.ones((self.model.epsy.shape[0], 2), dtype=bool)
+        held, failed = 0.0, 0
+        self.source.begin()
+        while True:
+            holding, until = self.schedule.stretch(self.clock.time)
+            draw = self.source.draw(self.clock.time, allowed, 0.0 if holding else self.speed, until, stream)
+            if holding:
+                held += draw.dt
+            self.source.settle(draw)
+            self.clock.advance_to(draw.time)
+            if draw.kind == NONE:
+                continue
+            row = {"yield_element": False, "hop_block": -1, "hop_direction": 0, "failed_hops": failed, "held": held,
+                   **self.source.columns(draw)}
+            if draw.kind != HOP:
+                self.pending = Pending(draw.kind, draw.block, depth=draw.depth)
+                return row
+            loaded = self.stack.stored()
+            if self.hop(draw.block, draw.direction, margin):
+                sign = 1 if draw.direction == FORWARD else -1
+                self.pending = Pending(HOP, draw.block, sign, after=self.stack.stored())
+                self.stack.restore(*loaded)
+                return {**row, "hop_block": draw.block, "hop_direction": sign}
+            failed += 1
+            allowed[draw.block, draw.direction] = False
+            self.source.undo(loaded)
 
     def hop(self, block, direction, margin):
         """Carry ``block`` over its edge in ``direction`` and relax; restore the state if it falls back.
@@ -230,69 +226,21 @@ class ThermalProtocol(AthermalProtocol):
             return False
         return True
 
-    def _load(self, margin, increment):
-        stack = self.stack
-        start = stack.stored()
-        t = start[3]
-        stream = self._stream(increment)
-        ds_c = self.loading.step_size(False)
-        model = self.model
-        allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
-        ds, held, failed = 0.0, 0.0, 0
-        while True:
-            holding, until = self.schedule.stretch(t)
-            speed = 0.0 if holding else self.speed
-            idx, eps = stack.read("idx", "eps")  # a failed hop may have moved the held wells: read them anew
-            kind, block, direction, dt = sample_event(
-                model.law, stack.yield_strains, idx, eps, self.loading.response.delta_eps, model.iface_dV, allowed,
-                self.beta, self.params.attempt_rate, ds, speed, until - t, ds_c, *stream)
-            if holding:
-                held += dt
-            else:
-                ds += speed * dt
-            if kind == NONE:
-                t = until
-                continue
-            t += dt
-            sign = 1 if direction == FORWARD else -1
-            if kind != HOP:
-                self.loading.step(False)
-                stack.set_time(t)
-                self.pending = (-1, 0)
-                return {"yield_element": False, "hop_block": -1, "hop_direction": 0, "failed_hops": failed,
-                        "held": held}
-            self.loading.load(ds)
-            stack.set_time(t)
-            loaded = stack.stored()
-            if self.hop(block, direction, margin):
-                stack.set_time(t)  # avalanches take no time
-                self._after = stack.stored()
-                stack.restore(*loaded)
-                self.pending = (block, sign)
-                return {"yield_element": False, "hop_block": block, "hop_direction": sign, "failed_hops": failed,
-                        "held": held}
-            failed += 1
-            allowed[block, direction] = False
-            stack.restore(*start)
-
-    def _event(self, margin):
-        stack = self.stack
-        block, sign = self.pending
-        t = stack.time
+    def perform(self, pending, margin):
+        """The event ``pending`` (:class:`Pending`): the athermal kick, or the hop (its state after the avalanche,
+        redone if the run was resumed at its load increment)."""
         yield_element = False
-        if block < 0:
-            converged, yield_element = self.kick(margin)
-            stack.set_time(t)
+        if pending.kind == THRESHOLD:
+            yield_element = self.kick(margin)[1]
         else:
-            if self._after is None:  # resumed at the load increment: redo the hop drawn there
-                if not self.hop(block, FORWARD if sign > 0 else BACKWARD, margin):
-                    raise SolverError(f"the stored hop of block {block} fell back when redone")
-                stack.set_time(t)
-                self._after = stack.stored()
-            stack.restore(*self._after)
-        self.pending, self._after = None, None
-        return {"yield_element": yield_element, "hop_block": block, "hop_direction": sign, "failed_hops": 0,
-                "held": 0.0}
+            after = pending.after
+            if after is None:
+                if not self.hop(pending.block, FORWARD if pending.sign > 0 else BACKWARD, margin):
+                    raise SolverError(f"the stored hop of block {pending.block} fell back when redone")
+                after = self.stack.stored()
+            self.stack.restore(*after)  # at rest: as the stored state (no velocity left from the avalanche)
+        return {"yield_element": yield_element, "hop_block": pending.block, "hop_direction": pending.sign,
+                "failed_hops": 0, "held": 0.0}
 
     def stored(self, row):
         """After an event increment: a slip (``A_a == N`` for some interface) starts a hold."""

@@ -110,9 +110,6 @@ class CpuBackend(Backend):
         s.t[0] = t
         self._evaluate(True)
 
-    def set_time(self, t):
-        self.state.t[0] = t
-
     def set_load_direction(self, delta_u, delta_target, delta_lever):
         self._direction = (np.asarray(delta_u, dtype=np.float64), np.asarray(delta_target, dtype=np.float64),
                            float(delta_lever))

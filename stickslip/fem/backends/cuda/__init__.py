@@ -109,9 +109,6 @@ class CudaBackend(Backend):
         self.batch.upload(self.slot, u=u, v=zeros, a=zeros, target=target, lever0=lever_target, clock=t)
         self.batch.evaluate(self.slot, True)
 
-    def set_time(self, t):
-        self.batch.upload(self.slot, clock=t)
-
     def set_load_direction(self, delta_u, delta_target, delta_lever):
         self.batch.upload(self.slot, delta_u=delta_u, delta_target=delta_target, delta_lever=np.array(delta_lever))
 
