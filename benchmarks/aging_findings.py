@@ -3,7 +3,7 @@
     python benchmarks/aging_findings.py results/aging
 
 Reads the aging study's ``thermal-events`` outputs (``STUDY/events/thermal-events/fem/*.h5``) and its runs
-(``STUDY/sim/fem/*.h5``) with :mod:`stickslip.events.aging_summary` and prints, each with the states, slips or
+(``STUDY/sim/fem/*.h5``) with :mod:`stickslip.summaries.aging_summary` and prints, each with the states, slips or
 holds behind it (standard errors over the states of paired hold trials, pooled over the seeds):
 
 1. per run: events (hops, athermal kicks, redraw events), junction redraws, steady-state slips, peak and drop;
@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from stickslip.events.aging_summary import (aftershock_pairs, curvature, driven_aftershocks, estimator, load_aging_runs,
+from stickslip.summaries.aging_summary import (aftershock_pairs, curvature, driven_aftershocks, estimator, load_aging_runs,
                                             mean_sem, paired_slopes, rate_slope, ratio, select_runs, trial_peaks)
 from stickslip.experiment.aging import spread_of_aging_rate
 from stickslip.formats.fem_run import read_increments

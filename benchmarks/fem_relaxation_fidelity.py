@@ -21,7 +21,7 @@ end state is from the exact equilibrium of its own wells (the dynamic tolerance'
 present; the exact one is the ``time-step`` run with ``dt_scale`` 1), then the steady-state
 slip statistics of each (:mod:`stickslip.events.extraction`): rho(s), P(Delta mu_a) and the
 sizes ``S`` (well changes, all interfaces) of all steady-state events, compared by the tests
-of :mod:`stickslip.events.sample_comparison`, each with the difference it could detect. Last
+of :mod:`stickslip.statistics.sample_comparison`, each with the difference it could detect. Last
 line ``slips=<dynamic>,<exact> rho_p=<chi2 p> dmu_ks_p=<KS p> dmu_ad_p=<AD p>
 size_ad_p=<AD p>``. ``--stored`` analyses the files as they are (a run still going, or
 stopped before ``--increments``, is read up to its last committed increment). ``--start K``
@@ -57,7 +57,7 @@ from scipy.sparse.linalg import eigsh
 
 from stickslip import registry
 from stickslip.events.extraction import classify_increments, slip_interfaces, steady_slips
-from stickslip.events.sample_comparison import SlipSample, compare_slip_samples
+from stickslip.statistics.sample_comparison import SlipSample, compare_slip_samples
 from stickslip.fem.backends import make_backend
 from stickslip.fem.observables import Observer
 from stickslip.fem.parameters import FemParams
@@ -171,7 +171,7 @@ def _slip_sample(label, params, args):
 
 
 def _compare(first, second):
-    """Print the two-sample tests (:func:`stickslip.events.sample_comparison.compare_slip_samples`); summary line."""
+    """Print the two-sample tests (:func:`stickslip.statistics.sample_comparison.compare_slip_samples`); summary line."""
     r = compare_slip_samples(first, second)
     d, z = r["dmu"], r["size"]
     print(f"  rho(s): {np.round(r['rho_1'], 3).tolist()} against {np.round(r['rho_2'], 3).tolist()}, chi-square "

@@ -11,11 +11,11 @@ numbers of the table in docs/numerical-analysis.md, "The paper's numerical state
 - periodicity and synchronisation (:mod:`stickslip.events.periodicity`): mean +- standard error
   over the runs (seeds);
 - the stress drops of compliant single slips against n = 1 (Fig. 2f):
-  :func:`stickslip.events.size_series.drop_shift_by_size`;
+  :func:`stickslip.summaries.size_series.drop_shift_by_size`;
 - Delta gamma_1 between slips of interface 1 (the SI's P(Delta gamma_a)): median and mean;
 - sequences (the SI's Fig. S3): fraction of slip events in single-slip sequences and in any sequence;
 - the front speed c_f and the delay tau of the re-run multi-slips (SI "Front dynamics"):
-  :func:`stickslip.events.size_series.front_speed_by_size`.
+  :func:`stickslip.summaries.size_series.front_speed_by_size`.
 """
 
 import math
@@ -27,7 +27,7 @@ import pandas as pd
 
 from stickslip.events.extraction import sequence_fractions, slip_fractions
 from stickslip.events.analysis_files import read_analysis_file
-from stickslip.events.size_series import (GROUP, drop_shift_by_size, front_speed_by_size, periodicity_by_size,
+from stickslip.summaries.size_series import (GROUP, drop_shift_by_size, front_speed_by_size, periodicity_by_size,
                                           run_key)
 from stickslip.fem.stiffness import at_paper_phi
 from stickslip.figures.numerical_common import run_phi

@@ -83,6 +83,8 @@ def test_relaxations_leave_a_protocol_clock_alone_and_it_never_goes_back():
     assert stack.time == 2.5 and stack.stored()[3] == 2.5
     with pytest.raises(ValueError, match="cannot go back"):
         clock.advance_to(1.0)
+    with pytest.raises(ValueError, match="cannot go back"):
+        Clock(3.0).advance_to(2.999)
     state = stack.stored()
     clock.advance_to(7.0)
     stack.restore(*state)  # a restore sets the stored state's time with the rest of it
@@ -97,7 +99,6 @@ def test_a_protocol_overrides_hooks_not_the_loop():
     assert "step" not in vars(ThermalProtocol) and "step" not in vars(AgingProtocol)
     assert not {"next_event", "_load", "step"} & set(vars(AgingProtocol))
     assert {"perform", "after_event"} <= set(vars(AgingProtocol))
-    assert isinstance(Clock(0.0).time, float)
 
 
 def test_no_class_of_the_fem_core_outgrows_150_lines_and_nothing_sets_a_time():

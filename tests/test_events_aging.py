@@ -16,8 +16,8 @@ import pandas as pd
 import pytest
 
 from stickslip import registry
-from stickslip.events.aging_summary import curvature, driven_aftershocks, paired_slopes
-from stickslip.events.omori import bootstrap_omori, fit_omori, omori_rate_integral
+from stickslip.summaries.aging_summary import curvature, driven_aftershocks, paired_slopes
+from stickslip.statistics.omori import bootstrap_omori, fit_omori, omori_rate_integral
 from stickslip.h5io import open_file, read_table
 from stickslip.lineage import Artifact
 from stickslip.plugin_params import parse_params

@@ -130,15 +130,18 @@ def test_the_readers_refuse_a_file_without_a_header_field_or_of_another_format(t
 
 
 def test_the_analyses_load_no_module_of_the_solver():
-    # every module of stickslip.events and the experimental analysis, in a fresh interpreter
+    # every module of the analyses (one run's, a study's, their statistics) and the experimental analysis, in a fresh
+    # interpreter
     probe = ("import importlib, pkgutil, sys\n"
-             "import stickslip.events\n"
-             "for module in pkgutil.iter_modules(stickslip.events.__path__):\n"
-             "    importlib.import_module('stickslip.events.' + module.name)\n"
+             "for name in ('events', 'summaries', 'statistics'):\n"
+             "    package = importlib.import_module('stickslip.' + name)\n"
+             "    for module in pkgutil.iter_modules(package.__path__):\n"
+             "        importlib.import_module(f'stickslip.{name}.{module.name}')\n"
              "import stickslip.experiment.analysis\n"
              "print(sorted(m for m in sys.modules if m == 'stickslip.fem' or m.startswith('stickslip.fem.')))\n"
-             "print(len([m for m in sys.modules if m.startswith('stickslip.events.')]))")
+             "print(len([m for m in sys.modules if m.startswith(('stickslip.events.', 'stickslip.summaries.', "
+             "'stickslip.statistics.'))]))")
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
-    loaded, events = done.stdout.split("\n")[:2]
+    loaded, analyses = done.stdout.split("\n")[:2]
     assert loaded == "[]"
-    assert int(events) >= 6  # the probe did import the analyses
+    assert int(analyses) >= 13  # the probe did import the analyses

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from stickslip.events.mean_shift import detectable_shift, shift_test
+from stickslip.statistics.mean_shift import detectable_shift, shift_test
 
 
 def _samples(rng, shift, m, repeats):

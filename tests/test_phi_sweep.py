@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stickslip.events.phi_sweep import crossover, sweep_table, wilson_interval
+from stickslip.summaries.phi_sweep import crossover, sweep_table, wilson_interval
 from stickslip.events.analysis_files import AnalysisFile
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from stickslip.events.sample_comparison import (SlipSample, compare_distributions, compare_slip_samples,
+from stickslip.statistics.sample_comparison import (SlipSample, compare_distributions, compare_slip_samples,
                                                  ks_resolution, multi_slip_resolution)
 
 

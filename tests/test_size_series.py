@@ -6,9 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stickslip.events import fronts, plugin, size_series
+from stickslip.events import fronts, plugin
+from stickslip.summaries import size_series
 from stickslip.events.analysis_files import read_analysis_file
-from stickslip.events.mean_shift import shift_test
+from stickslip.statistics.mean_shift import shift_test
 from stickslip.plugin_params import parse_params
 from test_events_extraction import history, run_attrs
 from test_fronts import C_D, C_S, H_BLOCK, SPACING, rupture

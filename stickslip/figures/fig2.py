@@ -7,7 +7,7 @@ interface, multi-slip drops black. (c) rho(s), the fraction of slip events invol
 interfaces, for every n: stiff dashed, compliant solid. (f) Density of the stress drop
 Delta mu_a [sig0] of the slipping interface in single-slip events, compliant driving, every n,
 with Welch's test of equal means between the smallest and the largest n and the shift it
-would detect (:mod:`stickslip.events.mean_shift`), beside the paper's finding (no shift).
+would detect (:mod:`stickslip.statistics.mean_shift`), beside the paper's finding (no shift).
 Beyond the paper's figure (:mod:`stickslip.events.periodicity`), against n, stiff dashed and
 compliant solid, mean over the runs (seeds) with one standard error: (g) periodicity, the
 coefficient of variation of the shear increment Delta gamma between consecutive slip events
@@ -23,7 +23,7 @@ import numpy as np
 
 from ..events.extraction import interfaces_in, slip_fractions
 from ..events.analysis_files import group_runs, pooled
-from ..events.mean_shift import shift_test
+from ..statistics.mean_shift import shift_test
 from ..plugin_params import param
 from ..registry import register
 from .numerical_common import REGIME_LINESTYLE, read_inputs, run_phi

@@ -1,6 +1,6 @@
 """Beyond the paper: junction aging in the fem model (docs/numerical-analysis.md, "Junction aging").
 
-Reads the ``thermal-events`` outputs of an aging study (:func:`stickslip.events.aging_summary.load_aging_runs`)
+Reads the ``thermal-events`` outputs of an aging study (:func:`stickslip.summaries.aging_summary.load_aging_runs`)
 and groups the runs by what the files say (``n_interfaces``, ``temperature``, ``drive_rate``,
 ``junction_strengthening``):
 
@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from .. import registry
-from ..events.aging_summary import estimator, load_aging_runs, mean_sem, paired_slopes, select_runs, trial_peaks
+from ..summaries.aging_summary import estimator, load_aging_runs, mean_sem, paired_slopes, select_runs, trial_peaks
 from ..experiment.aging import log_binned
 from ..h5io import FileFormatError
 from ..plugin_params import param

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ..events.phi_sweep import crossover, sweep_table
+from ..summaries.phi_sweep import crossover, sweep_table
 from ..fem.stiffness import PAPER_PHI
 from ..registry import register
 from .numerical_common import read_inputs, run_phi

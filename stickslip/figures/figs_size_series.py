@@ -1,7 +1,7 @@
 """Figure beyond the paper: the paper's numerical findings against the system size N.
 
 Runs at the paper's two Phi, grouped by (N, dt_scale, regime, n) with the seeds pooled
-(:mod:`stickslip.events.size_series`); filled markers dt_scale 4 (or the study's only time step),
+(:mod:`stickslip.summaries.size_series`); filled markers dt_scale 4 (or the study's only time step),
 open markers (shifted right by 5 %) the paper's time step dt_scale 1 where the study has it.
 (a) Synchronisation, stiff driving: multi-slip fraction (solid) and fraction of slip events in
 which all n interfaces slip (dashed), mean over the seeds with one standard error; the paper's
@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from ..events.size_series import drop_shift_by_size, front_speed_by_size, periodicity_by_size
+from ..summaries.size_series import drop_shift_by_size, front_speed_by_size, periodicity_by_size
 from ..registry import register
 from .numerical_common import read_inputs
 from .plotting import label_panels, n_style
@@ -32,7 +32,7 @@ NAME = "figS-size-series"
 #: The paper's system size, and its front speed [c_s].
 PAPER_N, PAPER_C_F = 1458, 2.0
 
-#: Standard errors in the detectable shift of :func:`stickslip.events.mean_shift.detectable_shift`
+#: Standard errors in the detectable shift of :func:`stickslip.statistics.mean_shift.detectable_shift`
 #: (z_0.975 + z_0.8): the shift's standard error is the detectable shift over this.
 DETECTABLE_IN_ERRORS = 2.8016
 

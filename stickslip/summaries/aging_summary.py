@@ -30,8 +30,8 @@ import pandas as pd
 
 from ..experiment.aging import fit_aging
 from ..formats.analysis_file import open_analysis_file
-from .omori import bootstrap_omori
-from .analysis_files import read_analysis_file
+from ..events.analysis_files import read_analysis_file
+from ..statistics.omori import bootstrap_omori
 
 __all__ = ["TABLES", "load_aging_runs", "select_runs", "first_peaks", "trial_peaks", "paired_slopes", "curvature", "ratio", "rate_slope",
            "estimator", "aftershock_pairs", "driven_aftershocks", "mean_sem"]

@@ -18,7 +18,7 @@ apart" means little without it:
   p-value) and Anderson-Darling (p-value by permutation, valid with ties); resolution of KS:
   the distance ``D`` that is significant at ``alpha`` (asymptotic, ``sqrt(-ln(alpha / 2) / 2)
   sqrt((m_1 + m_2) / (m_1 m_2))``). Delta mu_a also gets Welch's test of the means and its
-  detectable relative shift (:func:`stickslip.events.mean_shift.shift_test`).
+  detectable relative shift (:func:`stickslip.statistics.mean_shift.shift_test`).
 """
 
 import math

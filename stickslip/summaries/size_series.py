@@ -10,7 +10,7 @@ the seeds (the events of one run are not independent):
   over the runs;
 - :func:`drop_shift_by_size`: the n-dependence of the stress drop Delta mu_a of compliant single
   slips (the paper's Fig. 2f: none), n against n = 1: Welch's test on the pooled events with the
-  shift it resolves (:func:`stickslip.events.mean_shift.shift_test`) and Welch's test on the run
+  shift it resolves (:func:`stickslip.statistics.mean_shift.shift_test`) and Welch's test on the run
   means (one value per seed);
 - :func:`front_speed_by_size`: the front speed c_f of the re-run multi-slips (the paper: ~2 c_s),
   meaningful fits only (:func:`stickslip.events.fronts.analyse_event`), and the delay tau.
@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from . import periodicity
-from .mean_shift import shift_test
+from ..events import periodicity
+from ..statistics.mean_shift import shift_test
 
 __all__ = ["GROUP", "run_key", "periodicity_by_size", "drop_shift_by_size", "front_speed_by_size"]
 

@@ -1,0 +1,7 @@
+"""Statistics of samples of slips: is a shift of the mean resolved, do two samples differ, the Omori law of aftershocks.
+
+Each module is one test or fit with its resolution or confidence interval, on samples that the analyses of
+:mod:`stickslip.events` and :mod:`stickslip.experiment` produce: :mod:`.mean_shift` (a two-sample shift of the
+mean and the smallest shift detectable), :mod:`.sample_comparison` (two runs' slip statistics compared),
+:mod:`.omori` (the Omori-Utsu law fitted by maximum likelihood, bootstrapped over mainshocks).
+"""
