@@ -40,6 +40,12 @@ class Draw(NamedTuple):
         Time from the draw's start to the event (to the stretch's end for ``NONE``) [time].
     time : float
         Time of the event [time].
+    offset : float
+        Drive offset of the event [response units], counted as the source counts it (from the load increment's
+        start, or from the stack's state at the draw's start; for ``THRESHOLD`` with redraws, that of the last
+        redraw before it).
+    redraws : int
+        Junction redraws applied before the event within this draw.
     depth : float
         A redraw's new junction depth [G eps0^2 h^2] (not applied), else NaN.
     """
@@ -49,6 +55,8 @@ class Draw(NamedTuple):
     direction: int
     dt: float
     time: float
+    offset: float
+    redraws: int = 0
     depth: float = math.nan
 
 
@@ -108,14 +116,14 @@ class ArrheniusHops:
             self.beta, self.attempt_rate, self.offset, speed, until - t, self.threshold, *stream)
         if speed > 0.0:
             self.offset += speed * dt
-        return Draw(kind, block, direction, dt, until if kind == NONE else t + dt)
+        return Draw(kind, block, direction, dt, until if kind == NONE else t + dt, self.offset)
 
     def settle(self, draw):
         """Bring the stack to the event: to the brink for the threshold, along the drive to a hop's offset."""
         if draw.kind == THRESHOLD:
             self.loading.step(False)
         elif draw.kind != NONE:
-            self.loading.load(self.offset)
+            self.loading.load(draw.offset)
 
     def undo(self, loaded):
         """A hop fell back: the stack back to the increment's start, at the time of ``loaded`` (the state stored
@@ -147,7 +155,6 @@ class ArrheniusWithRedraws:
         self.beta, self.attempt_rate = beta, attempt_rate
         self.junctions, self.temperature = junctions, temperature
         self.redraws = 0
-        self._last = (0.0, 0)
 
     def begin(self):
         """Start a load increment (no redraw yet)."""
@@ -169,8 +176,7 @@ class ArrheniusWithRedraws:
             j.glass_temperature, j.attempt_rate, 1.0 / self.temperature, idx, eps, self.loading.response.delta_eps,
             m.iface_dV, allowed, self.beta, self.attempt_rate, speed, until - t, *stream)
         self.redraws += count
-        self._last = (offset, count)
-        return Draw(kind, block, direction, dt, t + dt, depth)
+        return Draw(kind, block, direction, dt, t + dt, offset, count, depth)
 
     def settle(self, draw):
         """Give the backend the junctions redrawn meanwhile and bring the stack to the draw's drive offset (to the
@@ -184,7 +190,7 @@ class ArrheniusWithRedraws:
         SolverError
             If a Gauss point left its well on the way (round-off at a yield strain).
         """
-        offset, redraws = self._last
+        offset, redraws = draw.offset, draw.redraws
         token = self.stack.watch()
         if redraws:
             self.stack.push_yield_strains()
