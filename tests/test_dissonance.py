@@ -151,3 +151,72 @@ def test_a_fit_that_the_bins_do_not_allow_says_why():
     assert math.isnan(row["B"]) and "bins" in row["reason"] and row["slips"] == 3
     multi = pd.DataFrame({"T": [10.0] * 20, "dmu": [0.1] * 20, "multi": [True] * 20})
     assert estimator_table(multi, t0=1.0, T="T", dmu="dmu")["slips"].tolist() == [0, 0]
+
+
+# --- through the solver: the true B of paired holds, with aging and without (N = 54, n = 1, about 40 CPU-s)
+
+SMALL = {"N": 54, "plates": 2, "seed": 1, "k_drive": 7.84e-4, "relaxation": "exact", "dt_scale": 4.0,
+         "max_increments": 300, "temperature": 1e-3, "drive_rate": 2e-6, "attempt_rate": 1.0}
+HOLDS = {"states": 10, "hold_times": (0.0, 1e6, 1e9, 1e12), "below": 0.1, "each": 1, "hold_interfaces": 1}
+
+
+def _run_and_hold(root, strengthening):
+    from stickslip import registry
+    from stickslip.lineage import Artifact
+    from stickslip.params import parse_params
+
+    solver = registry.get("solver", "fem")
+    params = parse_params(solver.params, {**SMALL, "junction_strengthening": strengthening})
+    raw = Artifact(root / f"run-{strengthening:g}.h5", registry.run_id(solver, params), solver.name, solver.produces)
+    solver.run(params, raw.path, threads=1, inputs={})
+    outputs = {}
+    for name, analysis_params in (("thermal-events", HOLDS), ("waiting-times", {})):
+        analysis = registry.get("analysis", name)
+        chosen = parse_params(analysis.params, analysis_params)
+        item = Artifact(root / f"{name}-{strengthening:g}.h5", registry.derived_run_id(analysis, chosen, [raw.run_id]),
+                        analysis.name, analysis.produces, raw)
+        analysis.run(chosen, raw, item.path)
+        outputs[name] = item.path
+    return outputs
+
+
+@pytest.fixture(scope="module")
+def held(tmp_path_factory):
+    root = tmp_path_factory.mktemp("dissonance-holds")
+    return {strengthening: _run_and_hold(root, strengthening) for strengthening in (20.0, 0.0)}
+
+
+@pytest.mark.slow
+def test_the_true_B_of_paired_holds_is_positive_with_aging_and_zero_without(held):
+    from stickslip.events.aging_summary import first_peaks, paired_slopes
+    from stickslip.events.dissonance_summary import peak_ages
+    from stickslip.events.results import read_analysis_file
+
+    slopes = {}
+    for strengthening, outputs in held.items():
+        item = read_analysis_file(outputs["thermal-events"], "event-table", ("slip_events", "holds", "trial_slips"))
+        peaks = peak_ages(first_peaks(item), item.tables["slip_events"])
+        assert np.all(peaks["age"] >= peaks["hold_time"]) and not peaks["failed_in_hold"].any()  # none fails at 0.1
+        assert np.all(peaks["age_start"] == 0.0)  # n = 1: the state is the interface's own slip
+        slopes[strengthening] = paired_slopes(peaks, t_min=0.0, time="age")
+    B, error, states = slopes[20.0]
+    assert states >= 8 and B > 4 * error  # measured 0.0086 +- 0.0016 over 10 states
+    B0, error0, states0 = slopes[0.0]
+    assert states0 >= 4 and abs(B0) < 3 * error0  # measured -0.0002 +- 0.0015 over 6 states
+    assert B - B0 > 3 * math.hypot(error, error0)
+
+
+@pytest.mark.slow
+def test_the_waiting_times_of_a_thermal_run_are_the_thermal_analysis_slips(held):
+    from stickslip.events.results import read_analysis_file
+
+    for outputs in held.values():
+        waits = read_analysis_file(outputs["waiting-times"], "event-table", ("slip_events", "spread"))
+        thermal = read_analysis_file(outputs["thermal-events"], "event-table", ("slip_events",))
+        mine, theirs = waits.tables["slip_events"], thermal.tables["slip_events"]
+        assert list(mine["increment"]) == list(theirs["increment"])
+        assert np.allclose(mine["T_fe"], theirs["T_fe"], equal_nan=True)
+        assert np.allclose(mine["dmu_sig0"], theirs["dmu_sig0"])
+        spread_row = waits.tables["spread"].iloc[0]
+        assert spread_row["n_slips"] == np.isfinite(mine["T_fe"]).sum()
+        assert spread_row["std_lnT"] == pytest.approx(np.log(mine["T_fe"].dropna()).std(ddof=1))

@@ -1,0 +1,260 @@
+"""The paper's test of aging replayed in the model: the numbers of docs/numerical-analysis.md, "Slip dissonance".
+
+    python benchmarks/dissonance_findings.py results/dissonance
+
+Reads the study of workflow/config/dissonance.yaml (its ``waiting-times``, ``thermal-events`` and ``experiment-events``
+outputs and its run files) and prints, each number with the slips, states or runs behind it:
+
+1. the drive's loading rate of every interface while nothing yields (the runs' linear responses), against the lab's
+   ``(n + a)(n - a + 1) / 2`` (relative to n = 1);
+2. the go/no-go scan: std(ln T_a) per interface for every drive setting and n (athermal runs: the drive since the
+   previous slip), pooled over n, and what makes it (the thresholds' spread, the share of the loading lost to
+   interruptions by other slips);
+3. the rate-and-state twin (the lab's drive on rate-and-state interfaces, B = b known by construction): the same
+   spread, and the paper's estimator per interface and pooled against the b put in, at two b for one b - a (the
+   twin cannot switch aging off: stick-slip needs b > a);
+4. the paper's estimator on the model's thermal runs (aging on, and the aging-off control) per interface, per n and
+   pooled, with the true B of item 5 beside it;
+5. the true B: paired holds at a load where no hold fails, the first peak after the hold against the contacts' age
+   at the peak (reload included) and against the hold time, per lambda and per interface in the stacks;
+6. what a measurement needs for 25 %: the slips and the spread of ln T, from the measured scatter, drop and
+   thresholds.
+"""
+
+import argparse
+import glob
+import json
+import math
+import warnings
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+
+from stickslip.events.aging_summary import (curvature, first_peaks, load_aging_runs, mean_sem, paired_slopes, ratio,
+                                            select_runs)
+from stickslip.events.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
+                                                 setting_of)
+from stickslip.events.estimator import biases, estimator_table, slips_needed
+from stickslip.figures.experimental_data import load_slips
+from stickslip.experiment.timeseries import read_truth
+
+#: The target of the scan: std(ln T_a) per interface (the paper's ~1.3, two decades of T_a).
+TARGET = 0.7
+
+
+def fmt(value, error, digits=3):
+    return f"{value:.{digits}f} ± {error:.{digits}f}"
+
+
+def lab_rates(n):
+    """The lab's loading rate of interfaces a = 1..n, relative to a single interface: (n + a)(n - a + 1) / 2."""
+    return np.array([(n + a) * (n - a + 1) / 2 for a in range(1, n + 1)])
+
+
+def rates_summary(study, runs):
+    print("## 1. Loading rates while nothing yields [sig0 per eps0 of drive] (linear response), relative to n = 1")
+    for setting, group in runs[~runs["thermal"]].groupby(runs.apply(setting_of, axis=1)):
+        reference = None
+        for _, run in group.sort_values("n").iterrows():
+            rates = loading_rates(Path(study) / "sim" / "fem" / Path(run["file"]).name)
+            if run["n"] == 1:
+                reference = rates[0]
+            relative = rates / reference if reference else rates * np.nan
+            print(f"- {setting}, n = {run['n']}: " + ", ".join(f"{r:.4f}" for r in rates)
+                  + f"; relative {', '.join(f'{r:.2f}' for r in relative)} (lab {', '.join(f'{r:g}' for r in lab_rates(run['n']))})")
+
+
+def scan_summary(runs):
+    print(f"\n## 2. The scan: std(ln T_a) per interface (target >= {TARGET}); athermal: T_a = drive since the "
+          "previous slip")
+    athermal = runs[~runs["thermal"]]
+    per_n, pooled = scan_table(athermal)
+    for row in per_n.itertuples():
+        print(f"- {row.setting}, n = {row.n}, a = {row.interface}: {fmt(row.std_lnT, row.std_lnT_error)} "
+              f"({row.n_slips} slips; 5-95 % over {row.decades:.2f} decades; median {row.median_T:.3f} eps0); "
+              f"thresholds alone std(ln recovered) {row.std_ln_recovered:.3f}; interrupted share "
+              f"{row.interrupted_share:.2f}")
+    print("- pooled over n (one clock, the drive):")
+    for row in pooled.itertuples():
+        verdict = "reaches" if row.std_lnT - 2 * row.std_lnT_error >= TARGET else (
+            "below" if row.std_lnT + 2 * row.std_lnT_error < TARGET else "undecided")
+        print(f"  {row.setting}, a = {row.interface}: {fmt(row.std_lnT, row.std_lnT_error)} ({row.n_slips} slips, "
+              f"{row.decades:.2f} decades) {verdict}")
+    return per_n, pooled
+
+
+def twin_summary(study):
+    paths = sorted(glob.glob(str(Path(study) / "events" / "experiment-events" / "rate-state-lever" / "*.h5")))
+    if not paths:
+        return None
+    print("\n## 3. The rate-and-state twin (rate-state-lever, stack, slips after 300 s)")
+    slips = load_slips(paths)
+    slips = slips[slips["protocol"] == "stack"].copy()
+    b_of = {}
+    for path in paths:
+        truth = read_truth(Path(study) / "sim" / "rate-state-lever" / Path(path).name, "interfaces")
+        b_of[path] = dict(zip(truth["interface"], truth["b"]))
+    slips["b"] = [b_of[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
+    slips["pair"] = [_pair(f) for f in slips["file"]]
+    for pair, group in slips.groupby("pair"):
+        print(f"- rs_a, rs_b = {pair}: {group['file'].nunique()} runs, {len(group)} slips")
+        table = _twin_spread(group)
+        for row in table.itertuples():
+            print(f"  spread a = {row.interface}, n = {row.n}: {fmt(row.std, row.error)} ({row.slips} slips)")
+        fits = estimator_table(group, t0=1.0, by=("interface",), T="T", dmu="dmu")
+        for row in fits.itertuples():
+            b = group.loc[group["interface"] == row.interface, "b"].mean()
+            print(f"  estimator a = {row.interface} ({row.fit}): B = {fmt(row.B, row.B_error, 4)} [{row.B_low:.4f}, "
+                  f"{row.B_high:.4f}], c = {fmt(row.c, row.c_error, 3)}; true B = b = {b:.4f}; B / b = "
+                  f"{row.B / b:.2f}; {row.slips} slips in {row.bins} bins, std(ln T) {row.std_lnT:.2f}")
+        for row in estimator_table(group, t0=1.0, T="T", dmu="dmu").itertuples():
+            print(f"  estimator pooled ({row.fit}): B = {fmt(row.B, row.B_error, 4)} [{row.B_low:.4f}, "
+                  f"{row.B_high:.4f}], c = {fmt(row.c, row.c_error, 3)}; mean b {group['b'].mean():.4f}; "
+                  f"{row.slips} slips, {row.bins} bins, std(ln T) {row.std_lnT:.2f}")
+    return slips
+
+
+def _pair(path):
+    """The (rs_a, rs_b) of the run an experiment-events file analysed (its header's parameters)."""
+    with h5py.File(path, "r") as file:
+        params = json.loads(file.attrs["params"])
+    return (tuple(params.get("rs_a", ())), tuple(params.get("rs_b", ())))
+
+
+def _twin_spread(slips):
+    rows = []
+    for (a, n), group in list(slips.groupby(["interface", "n"])) + [((a, 0), g) for a, g in slips.groupby("interface")]:
+        T = group["T"].to_numpy(dtype=float)
+        logs = np.log(T[np.isfinite(T) & (T > 0)])
+        std = logs.std(ddof=1) if logs.size > 1 else math.nan
+        rows.append({"interface": a, "n": n, "std": std, "error": std / math.sqrt(2 * max(logs.size - 1, 1)),
+                     "slips": logs.size})
+    return pd.DataFrame(rows)
+
+
+def true_peaks(runs):
+    """The first peak of every interface after every hold of the runs, with the contacts' age at the peak."""
+    parts = []
+    for k, item in enumerate(runs["data"]):
+        peaks = first_peaks(item)
+        if len(peaks):
+            parts.append(peak_ages(peaks, item.tables["slip_events"]).assign(run=k))
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
+
+
+def true_summary(study):
+    """Item 5: the true B of the paired holds, per setting; returns {(n, lambda, T, interface): (B, error, states)}."""
+    print("\n## 5. The true B: paired holds, first peak after the hold against ln(age at the peak) (hold + reload) "
+          "and against ln T_w (T_w >= 1e6)")
+    truth = {}
+    for analysis in ("thermal-events", "thermal-events@stack"):
+        every = load_aging_runs(sorted(glob.glob(str(Path(study) / "events" / analysis / "fem" / "*.h5"))))
+        every = every[every["trials"] == every["n"]]
+        for (n, lam, T, rate), runs in every.groupby(["n", "strengthening", "temperature", "drive_rate"]):
+            peaks = true_peaks(runs)
+            if peaks.empty:
+                continue
+            for below, part in peaks.groupby("below") if "below" in peaks else [(0.02, peaks)]:
+                held = part.drop_duplicates(["run", "state", "hold_time"])
+                for a, mine in part.groupby("interface"):
+                    age = paired_slopes(mine, t_min=0.0, time="age")
+                    hold = paired_slopes(mine)
+                    bend = curvature(mine.assign(hold_time=mine["age"]), t_min=0.0) if len(mine) > 5 else (
+                        math.nan, math.nan)
+                    reload = mean_sem(mine.loc[mine["hold_time"] == 0, "age"])
+                    print(f"- n = {n}, lambda {lam:g}, T {T:g}, rate {rate:g}, below {below:g}, a = {a}: B(age) = "
+                          f"{fmt(*age[:2], 4)} ({age[2]} states), B(T_w) = {fmt(*hold[:2], 4)} ({hold[2]}); "
+                          f"curvature in ln age {fmt(*bend, 5)}; age at the peak without a hold "
+                          f"{reload[0]:.3g} ± {reload[1]:.2g}; failed in the hold "
+                          f"{held['failed_in_hold'].mean():.2f} of {len(held)} holds; held stress "
+                          f"{held['mu_start'].mean():.3f} sig0")
+                    truth[(n, lam, T, below, a)] = age
+    return truth
+
+
+def scaling_summary(truth):
+    print("\n## 5b. Does B scale with lambda and T? (n = 1, below 0.1 and 0.02, age fits)")
+    for below in (0.1, 0.02):
+        base = truth.get((1, 5.0, 1e-3, below, 1))
+        if base is None:
+            continue
+        for key, name in (((1, 2.5, 1e-3, below, 1), "lambda 2.5"), ((1, 10.0, 1e-3, below, 1), "lambda 10"),
+                          ((1, 5.0, 2e-3, below, 1), "T 2e-3"), ((1, 0.0, 1e-3, below, 1), "aging off")):
+            if key in truth:
+                print(f"- below {below:g}: {name} / lambda 5: {fmt(*ratio(truth[key][0], truth[key][1], *base[:2]), 2)}"
+                      f" (the mechanism: lambda T ratio {key[1] * key[2] / 5e-3:.2f})")
+
+
+def estimator_summary(runs, truth):
+    print("\n## 4. The paper's estimator on the model's thermal runs (T_fe, T0 = 1 / nu): per interface and n, "
+          "per interface pooled over n, all pooled")
+    slips = estimator_runs(runs)
+    if slips.empty:
+        return
+    for setting, group in slips.groupby("setting"):
+        T0 = float(group["T0"].iloc[0])
+        tables = [estimator_table(group, t0=T0, by=("n", "interface"), T="T_fe", dmu="dmu_sig0"),
+                  estimator_table(group, t0=T0, by=("interface",), T="T_fe", dmu="dmu_sig0").assign(n=0),
+                  estimator_table(group, t0=T0, T="T_fe", dmu="dmu_sig0").assign(n=0, interface=0)]
+        for row in pd.concat(tables, ignore_index=True).itertuples():
+            where = ("pooled" if row.interface == 0 else f"a = {row.interface}") + (
+                f", n = {row.n}" if row.n else (", n pooled" if row.interface else ""))
+            print(f"- {setting}, {where} ({row.fit}): B = {fmt(row.B, row.B_error, 4)} [{row.B_low:.4f}, "
+                  f"{row.B_high:.4f}], c = {fmt(row.c, row.c_error, 3)}; {row.slips} slips, {row.bins} bins, "
+                  f"std(ln T) {row.std_lnT:.2f}, {row.decades:.2f} decades" + (f" ({row.reason})" if row.reason else ""))
+
+
+def requirements_summary(runs, truth):
+    print("\n## 6. What a measurement of B needs for 25 % (the estimator's standard error and its biases)")
+    slips = estimator_runs(runs)
+    for setting, group in slips.groupby("setting"):
+        single = group[~group["multi"].astype(bool) & np.isfinite(group["T_fe"])]
+        if len(single) < 10:
+            continue
+        one = single[single["n"] == 1]
+        drop, spread_drop = float(one["dmu_sig0"].mean()), float(one["dmu_sig0"].std(ddof=1))
+        logs = np.log(single["T_fe"] / float(group["T0"].iloc[0]))
+        lam = float(setting.split("lambda ")[1]) if "lambda" in setting else math.nan
+        true = truth.get((1, lam, float(setting.split("T ")[1].split()[0]), 0.1, 1)) if "T " in setting else None
+        if true is None or not np.isfinite(true[0]) or true[0] <= 0:
+            print(f"- {setting}: no true B > 0 to aim at")
+            continue
+        B = true[0]
+        cv = spread_drop / drop
+        need_var = drop * cv**2 / (0.25 * B)
+        print(f"- {setting}: true B {B:.4f} sig0, n = 1 drop {drop:.3f} ± std {spread_drop:.3f} (CV {cv:.2f}); "
+              f"the slips' std(ln T) {logs.std():.2f}: disorder-law bias of the free intercept "
+              f"{biases(gap=0, drop=drop, disorder=cv, std_lnT=logs.std(), mean_ln=logs.mean())['intercept']:.4f}"
+              f" = {biases(gap=0, drop=drop, disorder=cv, std_lnT=logs.std(), mean_ln=logs.mean())['intercept'] / B:.0f}"
+              f" B; below 25 % of B it needs std(ln T) > {math.sqrt(need_var):.1f}; then "
+              f"{slips_needed(B=B, residual=spread_drop, std_lnT=math.sqrt(need_var)):.0f} slips for a standard error "
+              f"of 25 %")
+    # the lab, with the paper's numbers and the twin's widths
+    print("- the lab (the paper's B = 0.053, drops ~0.2, n = 1 widths CV ~ 0.1 (the twin's path disorder: 5-8 %), "
+          "std(ln T) ~1.3): disorder-law bias of the free intercept "
+          f"{biases(gap=0, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['intercept']:.4f} "
+          f"({biases(gap=0, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['intercept'] / 0.053:.2f} B); "
+          f"slips for 25 %: {slips_needed(B=0.053, residual=0.03, std_lnT=1.3):.0f} at a scatter of 0.03 about the "
+          f"law; the origin fit's bias gap <x>/<x^2> = {biases(gap=0.04, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['origin']:.4f} "
+          "at the twin's gap c = 0.04")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("study", help="results directory of the dissonance study (e.g. results/dissonance)")
+    args = parser.parse_args(argv)
+    warnings.simplefilter("ignore", RuntimeWarning)
+    runs = load_runs(glob.glob(str(Path(args.study) / "events" / "waiting-times" / "fem" / "*.h5")))
+    rates_summary(args.study, runs)
+    scan_summary(runs)
+    twin_summary(args.study)
+    truth = true_summary(args.study)
+    scaling_summary(truth)
+    estimator_summary(runs, truth)
+    requirements_summary(runs, truth)
+
+
+if __name__ == "__main__":
+    main()
