@@ -24,7 +24,7 @@ from ..formats.analysis_file import open_analysis_file
 from .results import read_analysis_file
 from .waiting_times import spread_table
 
-__all__ = ["load_runs", "setting_of", "scan_table", "loading_rates", "peak_ages", "estimator_runs", "SETTING_KEYS"]
+__all__ = ["load_runs", "setting_of", "scan_table", "interface_rates", "loading_rates", "peak_ages", "estimator_runs", "SETTING_KEYS"]
 
 #: Columns of :func:`load_runs` that make a drive setting.
 SETTING_KEYS = ("drive", "lever_height", "k_drive", "temperature", "drive_rate", "strengthening")
@@ -97,12 +97,36 @@ def scan_table(runs):
             spread_table(slips, ("setting", "interface"), T="T"))
 
 
-def loading_rates(path):
-    """The loading rate of every interface of a fem run while no block yields [sig0 per eps0 of drive].
+def interface_rates(delta_eps, delta_target, delta_lever, top_height, eps0, free_lever):
+    """The loading rate of every interface along a linear response [sig0 per eps0 of drive].
 
-    From the run's stored linear response (``/event``): the interface's mean shear strain ``eps_xy`` per step
-    (its stress ``2 G eps_xy`` in units of ``sig0 = 2 G eps0``) over the drive per step (``gamma / eps0`` of a
-    fixed lever, ``x_target / eps0`` of a free lever).
+    Parameters
+    ----------
+    delta_eps : numpy.ndarray
+        [n N, 4, 3] the interface strains per step (:class:`stickslip.fem.linear_response.LinearResponse`).
+    delta_target : numpy.ndarray
+        [nlayer] the drive targets per step [length].
+    delta_lever : float
+        The free lever's drive target per step [length].
+    top_height : float
+        Mid-height of the top plate [length].
+    eps0 : float
+    free_lever : bool
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 [n]: the interface's mean shear strain ``eps_xy`` per step (its stress ``G eps_xy``, the equivalent
+        stress ``2 G eps_xy`` in units of ``sig0 = 2 G eps0``) over the drive per step (``gamma / eps0`` of a fixed
+        lever, ``x_target / eps0`` of a free lever), interfaces bottom to top.
+    """
+    drive = delta_lever / eps0 if free_lever else delta_target[-1] / (2.0 * top_height * eps0)
+    n = int(np.rint((delta_target.size - 1) / 2))
+    return delta_eps[:, :, 2].reshape(n, -1).mean(axis=1) / eps0 / drive
+
+
+def loading_rates(path):
+    """:func:`interface_rates` of a fem run, from its stored linear response (``/event``).
 
     Parameters
     ----------
@@ -112,7 +136,7 @@ def loading_rates(path):
     Returns
     -------
     numpy.ndarray
-        float64 [n], interfaces bottom to top.
+        float64 [n] [sig0 per eps0 of drive].
     """
     from ..formats.fem_run import read_run_attrs
     from ..mesh import load_mesh
@@ -122,9 +146,8 @@ def loading_rates(path):
         delta_eps, delta_target = file["event/delta_eps"][...], file["event/delta_target"][...]
         delta_lever = float(np.ravel(file["event/delta_lever"][...])[0])
         top = float(load_mesh(file["mesh"]).layer_mid_height[-1])
-    eps0, N = float(attrs["eps0"]), int(attrs["N"])
-    drive = delta_lever / eps0 if attrs.get("drive") == "free-lever" else delta_target[-1] / (2.0 * top * eps0)
-    return delta_eps[:, :, 2].reshape(-1, N * 4).mean(axis=1) / eps0 / drive
+    return interface_rates(delta_eps, delta_target, delta_lever, top, float(attrs["eps0"]),
+                           attrs.get("drive") == "free-lever")
 
 
 def peak_ages(peaks, slips):
