@@ -256,7 +256,7 @@ def test_a_compliant_drive_loads_every_interface_by_the_springs_above_it(plates)
     eps_xy = gamma on every interface whatever n (1.24 gamma on the top one, whose plate is held by its mean only)."""
     N, k = 18, 1e-9
     rates, mesh = _rates(N, plates, k)
-    assert rates == pytest.approx(2 * k * _lever_sums(mesh) / (1.0 * N * np.pi), rel=1e-6)
+    assert rates == pytest.approx(2 * k * _lever_sums(mesh) / (1.0 * N * np.pi), rel=1e-5)  # plates shear by O(k h_p^2 / mu)
     stiff, _ = _rates(N, plates, 10.0)
     assert np.all((stiff > 0.95) & (stiff < 1.25)) and abs(stiff[0] - 1.0) < 0.11
 
