@@ -163,7 +163,7 @@ HOLDS = {"states": 10, "hold_times": (0.0, 1e6, 1e9, 1e12), "below": 0.1, "each"
 def _run_and_hold(root, strengthening):
     from stickslip import registry
     from stickslip.lineage import Artifact
-    from stickslip.params import parse_params
+    from stickslip.plugin_params import parse_params
 
     solver = registry.get("solver", "fem")
     params = parse_params(solver.params, {**SMALL, "junction_strengthening": strengthening})
@@ -190,7 +190,7 @@ def held(tmp_path_factory):
 def test_the_true_B_of_paired_holds_is_positive_with_aging_and_zero_without(held):
     from stickslip.events.aging_summary import first_peaks, paired_slopes
     from stickslip.events.dissonance_summary import peak_ages
-    from stickslip.events.results import read_analysis_file
+    from stickslip.events.analysis_files import read_analysis_file
 
     slopes = {}
     for strengthening, outputs in held.items():
@@ -208,7 +208,7 @@ def test_the_true_B_of_paired_holds_is_positive_with_aging_and_zero_without(held
 
 @pytest.mark.slow
 def test_the_waiting_times_of_a_thermal_run_are_the_thermal_analysis_slips(held):
-    from stickslip.events.results import read_analysis_file
+    from stickslip.events.analysis_files import read_analysis_file
 
     for outputs in held.values():
         waits = read_analysis_file(outputs["waiting-times"], "event-table", ("slip_events", "spread"))

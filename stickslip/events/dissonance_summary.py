@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from ..formats.analysis_file import open_analysis_file
-from .results import read_analysis_file
+from .analysis_files import read_analysis_file
 from .waiting_times import spread_table
 
 __all__ = ["load_runs", "setting_of", "scan_table", "interface_rates", "loading_rates", "peak_ages", "estimator_runs", "SETTING_KEYS"]

@@ -29,7 +29,7 @@ from ..events.dissonance_summary import (estimator_runs, load_runs, loading_rate
 from ..events.estimator import estimate
 from ..experiment.aging import log_binned
 from ..h5io import FileFormatError
-from ..params import param
+from ..plugin_params import param
 from .plotting import label_panels, legend_outside, log_edges, plot_density
 from .style import n_color, plt, save_figure
 
