@@ -32,11 +32,11 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from stickslip.events.aging_summary import (curvature, first_peaks, load_aging_runs, mean_sem, paired_slopes, ratio,
+from stickslip.summaries.aging_summary import (curvature, first_peaks, load_aging_runs, mean_sem, paired_slopes, ratio,
                                             select_runs)
-from stickslip.events.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
+from stickslip.summaries.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
                                                  setting_of)
-from stickslip.events.estimator import biases, estimator_table, slips_needed
+from stickslip.statistics.estimator import biases, estimator_table, slips_needed
 from stickslip.figures.experimental_data import load_slips
 from stickslip.experiment.timeseries import read_truth
 

@@ -17,7 +17,7 @@ import pytest
 
 from stickslip import vocabulary
 from stickslip.events import extraction
-from stickslip.events.estimator import biases, estimate, estimator_table, slips_needed, synthetic_slips
+from stickslip.statistics.estimator import biases, estimate, estimator_table, slips_needed, synthetic_slips
 from stickslip.events.waiting_times import spread, spread_table, waiting_times
 from test_events_extraction import history
 
@@ -188,8 +188,8 @@ def held(tmp_path_factory):
 
 @pytest.mark.slow
 def test_the_true_B_of_paired_holds_is_positive_with_aging_and_zero_without(held):
-    from stickslip.events.aging_summary import first_peaks, paired_slopes
-    from stickslip.events.dissonance_summary import peak_ages
+    from stickslip.summaries.aging_summary import first_peaks, paired_slopes
+    from stickslip.summaries.dissonance_summary import peak_ages
     from stickslip.events.analysis_files import read_analysis_file
 
     slopes = {}
@@ -225,7 +225,7 @@ def test_the_waiting_times_of_a_thermal_run_are_the_thermal_analysis_slips(held)
 # --- the drive's loading rates while nothing yields: the lever's in the compliant limit, affine in the stiff one
 
 def _rates(N, plates, k_drive):
-    from stickslip.events.dissonance_summary import interface_rates
+    from stickslip.summaries.dissonance_summary import interface_rates
     from stickslip.fem.backends import make_backend
     from stickslip.fem.parameters import FemParams
     from stickslip.fem.simulation import Simulation

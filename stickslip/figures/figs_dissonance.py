@@ -1,6 +1,6 @@
 """Beyond the paper: its test of aging replayed in the fem model (docs/numerical-analysis.md, "Slip dissonance").
 
-Reads the ``waiting-times`` outputs of a study's fem runs (:func:`stickslip.events.dissonance_summary.load_runs`)
+Reads the ``waiting-times`` outputs of a study's fem runs (:func:`stickslip.summaries.dissonance_summary.load_runs`)
 and, if the study has them, its ``thermal-events`` outputs with hold trials:
 
 (a) P(T_1) of interface 1 against n (the paper's Fig. 5b) for the athermal drive setting with the broadest waiting
@@ -23,10 +23,10 @@ import numpy as np
 import pandas as pd
 
 from .. import registry
-from ..events.aging_summary import first_peaks, load_aging_runs, paired_slopes
-from ..events.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
+from ..summaries.aging_summary import first_peaks, load_aging_runs, paired_slopes
+from ..summaries.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
                                          setting_of)
-from ..events.estimator import estimate
+from ..statistics.estimator import estimate
 from ..experiment.aging import log_binned
 from ..h5io import FileFormatError
 from ..plugin_params import param

@@ -121,7 +121,7 @@ def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3, time="hold_time
     min_points : int
     time : str
         The time of the logarithm: ``hold_time`` (T_w), or a column of the contacts' age at the peak
-        (:func:`stickslip.events.dissonance_summary.peak_ages`).
+        (:func:`stickslip.summaries.dissonance_summary.peak_ages`).
 
     Returns
     -------

@@ -4,7 +4,7 @@ dissonance").
 - :func:`load_runs`: a study's ``waiting-times`` files, one row per run, with the drive they were made at (``drive``,
   ``lever_height``, ``k_drive``, ``phi``), ``n``, ``seed``, ``temperature``, ``drive_rate``, ``strengthening``.
 - :func:`setting_of`: the drive setting of a run as one label (runs of one setting differ in ``n`` and ``seed``).
-- :func:`scan_table`: per setting, ``n`` and interface the spread of ``ln T`` (:func:`.waiting_times.spread_table`),
+- :func:`scan_table`: per setting, ``n`` and interface the spread of ``ln T`` (:func:`stickslip.events.waiting_times.spread_table`),
   and per setting and interface the same pooled over ``n`` (the paper's Fig. 5b pools P(T_a) of one interface over
   the stacks; with one clock for every ``n`` the shift of T with ``n`` broadens the pool).
 - :func:`loading_rates`: the rate at which the drive loads every interface of a run while nothing yields (its
@@ -13,7 +13,7 @@ dissonance").
   interface's contacts at its peak: the time since the hold's start (hold and reload) plus the time between the
   interface's last slip and the state held (0 for the interface whose slip the state is).
 - :func:`estimator_runs`: the single slips of thermal runs with their waiting time ``T_fe`` and drop, ready for
-  :func:`.estimator.estimator_table`.
+  :func:`stickslip.statistics.estimator.estimator_table`.
 """
 
 import h5py
@@ -21,8 +21,8 @@ import numpy as np
 import pandas as pd
 
 from ..formats.analysis_file import open_analysis_file
-from .analysis_files import read_analysis_file
-from .waiting_times import spread_table
+from ..events.analysis_files import read_analysis_file
+from ..events.waiting_times import spread_table
 
 __all__ = ["load_runs", "setting_of", "scan_table", "interface_rates", "loading_rates", "peak_ages", "estimator_runs", "SETTING_KEYS"]
 
@@ -37,7 +37,7 @@ def load_runs(paths):
     -------
     pandas.DataFrame
         ``file``, ``n``, ``seed``, ``phi``, :data:`SETTING_KEYS`, ``thermal`` and ``data``
-        (:class:`.results.AnalysisFile` with the tables ``slip_events`` and ``spread``).
+        (:class:`stickslip.events.analysis_files.AnalysisFile` with the tables ``slip_events`` and ``spread``).
     """
     rows = []
     for path in sorted(map(str, paths)):
@@ -81,7 +81,7 @@ def scan_table(runs):
     -------
     tuple[pandas.DataFrame, pandas.DataFrame]
         Per (``setting``, ``n``, ``interface``) and per (``setting``, ``interface``) pooled over ``n`` and seeds:
-        :func:`.waiting_times.spread_table`'s columns (of ``T_fe`` in thermal runs, ``wait_drive`` else).
+        :func:`stickslip.events.waiting_times.spread_table`'s columns (of ``T_fe`` in thermal runs, ``wait_drive`` else).
     """
     parts = []
     for _, run in runs.iterrows():
