@@ -17,7 +17,7 @@ import pytest
 
 from stickslip import vocabulary
 from stickslip.events import extraction
-from stickslip.statistics.estimator import biases, estimate, estimator_table, slips_needed, synthetic_slips
+from stickslip.statistics.estimator import biases, estimate, estimator_table, synthetic_slips
 from stickslip.events.waiting_times import spread, spread_table, waiting_times
 from test_events_extraction import history
 
@@ -142,8 +142,6 @@ def test_the_binned_fit_has_the_straight_lines_standard_error():
     predicted = residual / (math.sqrt(m) * np.mean([fit.std_lnT for fit in fits]))
     assert estimates.std(ddof=1) == pytest.approx(predicted, rel=0.35)
     assert np.median([fit.B_error for fit in fits]) == pytest.approx(predicted, rel=0.35)  # the fit's own error
-    assert slips_needed(B=B, residual=residual, std_lnT=1.0, precision=0.25) == pytest.approx(
-        (residual / (0.25 * B)) ** 2)
 
 
 def test_a_fit_that_the_bins_do_not_allow_says_why():
@@ -176,7 +174,7 @@ def _run_and_hold(root, strengthening):
         item = Artifact(root / f"{name}-{strengthening:g}.h5", registry.derived_run_id(analysis, chosen, [raw.run_id]),
                         analysis.name, analysis.produces, raw)
         analysis.run(chosen, raw, item.path)
-        outputs[name] = item.path
+        outputs[name] = item
     return outputs
 
 
@@ -220,6 +218,42 @@ def test_the_waiting_times_of_a_thermal_run_are_the_thermal_analysis_slips(held)
         spread_row = waits.tables["spread"].iloc[0]
         assert spread_row["n_slips"] == np.isfinite(mine["T_fe"]).sum()
         assert spread_row["std_lnT"] == pytest.approx(np.log(mine["T_fe"].dropna()).std(ddof=1))
+
+
+@pytest.mark.slow
+def test_the_dissonance_figure_draws_the_true_B_and_the_estimate_of_each_run(held, tmp_path):
+    """Panel (e): the true B per lambda (paired holds against the age at the peak) and the estimator's B of the same
+    runs, the numbers of the summaries; the figure's files are written."""
+    from stickslip import registry
+    from stickslip.events.analysis_files import read_analysis_file
+    from stickslip.figures import figs_dissonance
+    from stickslip.plugin_params import parse_params
+    from stickslip.summaries.aging_summary import first_peaks, paired_slopes
+    from stickslip.summaries.dissonance_summary import peak_ages
+
+    inputs = {figs_dissonance.WAITS: [outputs["waiting-times"] for outputs in held.values()],
+              figs_dissonance.THERMAL: [outputs["thermal-events"] for outputs in held.values()]}
+    figure = registry.get("figure", "figS-dissonance")
+    params = parse_params(figure.params, {})
+    drawn = figs_dissonance.draw(params, inputs).axes[4]
+    truth = drawn.lines[0].get_xydata()
+    for strengthening, (lam, B) in zip(sorted(held), truth):
+        item = read_analysis_file(held[strengthening]["thermal-events"], "event-table",
+                                  ("slip_events", "holds", "trial_slips"))
+        expected = paired_slopes(peak_ages(first_peaks(item), item.tables["slip_events"]).assign(run=0), t_min=0.0,
+                                 time="age")[0]
+        assert lam == strengthening and B == pytest.approx(expected)
+    for strengthening in held:
+        waits = read_analysis_file(held[strengthening]["waiting-times"], "event-table", ("slip_events",))
+        slips = waits.tables["slip_events"]
+        single = slips[~slips["multi"]]
+        for fit, marker in (("origin", "x"), ("intercept", "+")):
+            value = estimate(single["T_fe"], single["dmu_sig0"], t0=1.0, fit=fit)["B"]
+            drawn_points = [line.get_xydata()[0] for line in drawn.lines if line.get_marker() == marker]
+            assert not np.isfinite(value) or any(
+                x == strengthening and y == pytest.approx(value) for x, y in drawn_points), (strengthening, fit)
+    figure.run(params, inputs, tmp_path / "figS-dissonance.pdf")
+    assert (tmp_path / "figS-dissonance.pdf").stat().st_size > 0 and (tmp_path / "figS-dissonance.png").exists()
 
 
 # --- the drive's loading rates while nothing yields: the lever's in the compliant limit, affine in the stiff one

@@ -158,25 +158,23 @@ def _truth_panel(ax, thermal, estimates):
         ax.text(0.5, 0.5, "no hold trials", ha="center", transform=ax.transAxes)
         return
     runs = thermal[(thermal["n"] == 1) & (thermal["trials"] == 1)]
-    for (T, below), marker in zip(((T, b) for T in sorted(runs["temperature"].unique()) for b in (0.1, 0.02)),
-                                  "osD^v<>"):
-        rows = []
-        for lam, group in runs[np.isclose(runs["temperature"], T)].groupby("strengthening"):
-            peaks = [peak_ages(first_peaks(item), item.tables["slip_events"]).assign(run=k)
-                     for k, item in enumerate(group["data"])]
-            peaks = pd.concat(peaks, ignore_index=True)
-            if "below" in peaks:
-                peaks = peaks[np.isclose(peaks["below"], below)]
-            slope, error, states = paired_slopes(peaks, t_min=0.0, time="age")
+    curves = {}  # (T, below) -> [(lambda, B, error)]
+    for (T, lam), group in runs.groupby(["temperature", "strengthening"]):
+        peaks = pd.concat([peak_ages(first_peaks(item), item.tables["slip_events"]).assign(run=k)
+                           for k, item in enumerate(group["data"])], ignore_index=True)
+        for below, held in peaks.groupby("below"):
+            slope, error, states = paired_slopes(held, t_min=0.0, time="age")
             if states:
-                rows.append((lam, slope, error))
-        if rows:
-            rows = np.asarray(rows)
-            ax.errorbar(rows[:, 0], rows[:, 1], yerr=rows[:, 2], marker=marker, capsize=2,
-                        label=f"true B, T {T:g}, below {below:g}")
-    for (lam, fit), value in estimates.items():
+                curves.setdefault((T, below), []).append((lam, slope, error))
+    for ((T, below), rows), marker in zip(sorted(curves.items()), "osD^v<>"):
+        rows = np.asarray(rows)
+        ax.errorbar(rows[:, 0], rows[:, 1], yerr=rows[:, 2], marker=marker, capsize=2,
+                    label=f"true B, T {T:g}, below {below:g}")
+    labelled = set()
+    for (T, lam, fit), value in sorted(estimates.items()):
         ax.plot([lam], [value], marker="x" if fit == "origin" else "+", color="k", linestyle="none",
-                label=f"estimator ({fit})" if lam == max(k[0] for k in estimates) else None)
+                label=None if fit in labelled else f"estimator ({fit}), n = 1")
+        labelled.add(fit)
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     ax.set_xlabel(r"$\lambda$ [$\epsilon_0$ per $G\epsilon_0^2h^2$]")
     ax.set_ylabel(r"$B$ [$\sigma_0$ per e-fold]")
@@ -199,14 +197,13 @@ def draw(params, inputs):
     _, pooled = scan_table(athermal)
     thermal = load_aging_runs(item.path for item in inputs.get(THERMAL, []))
     slips = estimator_runs(runs)
-    estimates = {}
-    for setting, group in slips[slips["n"] == 1].groupby("setting") if not slips.empty else []:
-        lam = float(setting.split("lambda ")[1])
+    estimates = {}  # (temperature, lambda, fit) -> B of the runs n = 1
+    for (T, lam), group in slips[slips["n"] == 1].groupby(["temperature", "strengthening"]):
         single = group[~group["multi"].astype(bool)]
         for fit in ("origin", "intercept"):
             value = estimate(single["T_fe"], single["dmu_sig0"], t0=float(group["T0"].iloc[0]), fit=fit)["B"]
             if np.isfinite(value):
-                estimates[(lam, fit)] = value
+                estimates[(T, lam, fit)] = value
     fig, axes = plt.subplots(2, 3, figsize=(15.0, 7.4), layout="constrained")
     ax = axes.ravel()
     _waits_panel(ax[0], athermal, pooled)

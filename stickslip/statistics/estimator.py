@@ -16,10 +16,13 @@ four bins per decade, five slips per bin, inverse-variance weights, errors scale
   a factor of the loading path (log-normal, ``std(ln)`` = ``path_spread``: the interruptions by other
   interfaces' slips and the rate's dependence on ``n``), so that without aging the drop still correlates
   with ``T``;
-- :func:`biases` and :func:`slips_needed`: what that construction predicts for the two fits: the origin fit
-  reads the gap as aging (``+ gap <x> / <x^2>``, ``x = ln(T / T0)``: ``gap / <x>`` for narrow ``T``); the free intercept reads the disorder law
-  (``+ drop CV^2 / var(ln T)``, ``CV`` the thresholds' relative spread); and the slips a fit needs for a
-  standard error of ``precision B``.
+- :func:`biases`: what that construction predicts for the two fits: the origin fit reads the gap as aging
+  (``+ gap <x> / <x^2>``, ``x = ln(T / T0)``: ``gap / <x>`` for narrow ``T``); the free intercept reads the disorder
+  law (``+ drop CV^2 / var(ln T)``, ``CV`` the thresholds' relative spread).
+
+The binned fit's standard error is that of a straight line, ``residual / (sqrt(m) std(ln T))`` for ``m`` slips
+scattered by ``residual`` about the law (tested), so the slips a measurement needs for a relative error ``p`` scale
+from a fit's as ``m (B_error / (p B))^2``.
 """
 
 import math
@@ -30,7 +33,7 @@ from scipy import stats
 
 from ..experiment.aging import FITS, fit_aging
 
-__all__ = ["ESTIMATE_COLUMNS", "estimate", "estimator_table", "synthetic_slips", "biases", "slips_needed"]
+__all__ = ["ESTIMATE_COLUMNS", "estimate", "estimator_table", "synthetic_slips", "biases"]
 
 #: Columns of :func:`estimate` (and of every row of :func:`estimator_table` after its group keys).
 ESTIMATE_COLUMNS = ["fit", "B", "B_error", "B_low", "B_high", "c", "c_error", "c_low", "c_high", "slips", "bins",
@@ -174,25 +177,3 @@ def biases(*, gap, drop, disorder, std_lnT, mean_ln):
         ``cov(dmu, ln T) / var(ln T)`` without aging, where ``ln T`` carries ``ln(threshold)``).
     """
     return {"origin": gap * mean_ln / (mean_ln**2 + std_lnT**2), "intercept": drop * disorder**2 / std_lnT**2}
-
-
-def slips_needed(*, B, residual, std_lnT, precision=0.25):
-    """Slips for a standard error of ``precision B`` of a straight-line slope in ``ln T`` (free intercept).
-
-    ``error(B) = residual / (sqrt(m) std(ln T))`` for ``m`` slips scattered by ``residual`` about the line; the
-    binned fit of :func:`estimate` weights its bins by their counts and comes close to it (tested).
-
-    Parameters
-    ----------
-    B, residual : float
-        The aging rate and the scatter of the drops about the law [unit of the drops].
-    std_lnT : float
-    precision : float
-        Relative standard error wanted.
-
-    Returns
-    -------
-    float
-        ``m`` (not rounded).
-    """
-    return (residual / (precision * B * std_lnT)) ** 2

@@ -89,9 +89,8 @@ def scan_table(runs):
         parts.append(slips.assign(setting=setting_of(run), n=run["n"], seed=run["seed"],
                                   T=slips["T_fe"] if run["thermal"] else slips["wait_drive"]))
     if not parts:
-        empty = spread_table(pd.DataFrame(columns=["setting", "n", "interface", "T", "rise_sig0",
-                                                    "recovered_sig0", "interrupted_sig0"]), ("setting",), T="T")
-        return empty, empty
+        parts = [pd.DataFrame(columns=["setting", "n", "interface", "T", "rise_sig0", "recovered_sig0",
+                                       "interrupted_sig0"])]
     slips = pd.concat(parts, ignore_index=True)
     return (spread_table(slips, ("setting", "n", "interface"), T="T"),
             spread_table(slips, ("setting", "interface"), T="T"))
@@ -183,14 +182,15 @@ def estimator_runs(runs):
     Returns
     -------
     pandas.DataFrame
-        ``setting``, ``n``, ``seed``, ``interface``, ``multi``, ``T_fe`` [time], ``dmu_sig0`` [sig0], ``T0``
-        (``1 / attempt_rate`` [time]).
+        ``setting``, ``temperature``, ``strengthening``, ``n``, ``seed``, ``interface``, ``multi``, ``T_fe`` [time],
+        ``dmu_sig0`` [sig0], ``T0`` (``1 / attempt_rate`` [time]).
     """
     parts = []
     for _, run in runs[runs["thermal"]].iterrows():
         slips = run["data"].tables["slip_events"]
         T0 = 1.0 / float(run["data"].attrs["params"].get("attempt_rate", 1.0))
         parts.append(slips[["interface", "multi", "T_fe", "dmu_sig0"]].assign(
-            setting=setting_of(run), n=run["n"], seed=run["seed"], T0=T0))
-    columns = ["setting", "n", "seed", "interface", "multi", "T_fe", "dmu_sig0", "T0"]
+            setting=setting_of(run), temperature=run["temperature"], strengthening=run["strengthening"], n=run["n"],
+            seed=run["seed"], T0=T0))
+    columns = ["setting", "temperature", "strengthening", "n", "seed", "interface", "multi", "T_fe", "dmu_sig0", "T0"]
     return pd.concat(parts, ignore_index=True)[columns] if parts else pd.DataFrame(columns=columns)
