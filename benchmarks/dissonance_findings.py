@@ -13,10 +13,11 @@ outputs and its run files) and prints, each number with the slips, states or run
 3. the rate-and-state twin (the lab's drive on rate-and-state interfaces, B = b known by construction): the same
    spread, and the paper's estimator per interface and pooled against the b put in, at two b for one b - a (the
    twin cannot switch aging off: stick-slip needs b > a);
-4. the paper's estimator on the model's thermal runs (aging on, and the aging-off control) per interface, per n and
-   pooled, with the true B of item 5 beside it;
-5. the true B: paired holds at a load where no hold fails, the first peak after the hold against the contacts' age
-   at the peak (reload included) and against the hold time, per lambda and per interface in the stacks;
+4. the true B: paired holds at a load where no hold fails, the first peak after the hold against the contacts' age
+   at the peak (reload included) and against the hold time, per lambda and per interface in the stacks, and its
+   ratio to lambda = 5 (does B scale with the junctions' strengthening?);
+5. the paper's estimator on the model's thermal runs (aging on, and the aging-off control) per interface, per n and
+   pooled, with the true B of item 4 beside it;
 6. what a measurement needs for 25 %: the slips and the spread of ln T, from the measured scatter, drop and
    thresholds.
 """
@@ -36,7 +37,7 @@ from stickslip.summaries.aging_summary import (curvature, first_peaks, load_agin
                                             select_runs)
 from stickslip.summaries.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
                                                  setting_of)
-from stickslip.statistics.estimator import biases, estimator_table, slips_needed
+from stickslip.statistics.estimator import biases, estimator_table
 from stickslip.figures.experimental_data import load_slips
 from stickslip.experiment.timeseries import read_truth
 
@@ -95,7 +96,7 @@ def twin_summary(study):
     b_of = {}
     for path in paths:
         truth = read_truth(Path(study) / "sim" / "rate-state-lever" / Path(path).name, "interfaces")
-        b_of[path] = dict(zip(truth["interface"], truth["b"]))
+        b_of[path] = dict(zip(truth["a"], truth["b"]))
     slips["b"] = [b_of[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
     slips["pair"] = [_pair(f) for f in slips["file"]]
     for pair, group in slips.groupby("pair"):
@@ -145,8 +146,8 @@ def true_peaks(runs):
 
 
 def true_summary(study):
-    """Item 5: the true B of the paired holds, per setting; returns {(n, lambda, T, interface): (B, error, states)}."""
-    print("\n## 5. The true B: paired holds, first peak after the hold against ln(age at the peak) (hold + reload) "
+    """Item 4: the true B of the paired holds, per setting; returns {(n, lambda, T, interface): (B, error, states)}."""
+    print("\n## 4. The true B: paired holds, first peak after the hold against ln(age at the peak) (hold + reload) "
           "and against ln T_w (T_w >= 1e6)")
     truth = {}
     for analysis in ("thermal-events", "thermal-events@stack"):
@@ -175,20 +176,33 @@ def true_summary(study):
 
 
 def scaling_summary(truth):
-    print("\n## 5b. Does B scale with lambda and T? (n = 1, below 0.1 and 0.02, age fits)")
-    for below in (0.1, 0.02):
+    print("\n## 4b. Does B scale with lambda and T? (n = 1, age fits, relative to lambda 5 at T 1e-3 and the same load)")
+    for (n, lam, T, below, a), value in sorted(truth.items()):
         base = truth.get((1, 5.0, 1e-3, below, 1))
-        if base is None:
+        if n != 1 or base is None or (lam, T) == (5.0, 1e-3):
             continue
-        for key, name in (((1, 2.5, 1e-3, below, 1), "lambda 2.5"), ((1, 10.0, 1e-3, below, 1), "lambda 10"),
-                          ((1, 5.0, 2e-3, below, 1), "T 2e-3"), ((1, 0.0, 1e-3, below, 1), "aging off")):
-            if key in truth:
-                print(f"- below {below:g}: {name} / lambda 5: {fmt(*ratio(truth[key][0], truth[key][1], *base[:2]), 2)}"
-                      f" (the mechanism: lambda T ratio {key[1] * key[2] / 5e-3:.2f})")
+        print(f"- below {below:g}: lambda {lam:g}, T {T:g} / lambda 5, T 1e-3: "
+              f"{fmt(*ratio(value[0], value[1], *base[:2]), 2)} (the mechanism, lambda T: {lam * T / 5e-3:.2f})")
+
+
+def truth_at(truth, lam, T):
+    """The true B of interface 1 at n = 1, (B, error, states), at the load farthest below the threshold; or None."""
+    keys = [key for key in truth if key[0] == 1 and key[1] == lam and key[2] == T and key[4] == 1]
+    return truth[max(keys, key=lambda key: key[3])] if keys else None
+
+
+def pooled_estimates(runs):
+    """Both fits on every single slip of each thermal setting, pooled over interfaces and n: {(T, lambda): table}."""
+    slips = estimator_runs(runs)
+    out = {}
+    for (T, lam), group in slips.groupby(["temperature", "strengthening"]):
+        out[(T, lam)] = estimator_table(group, t0=float(group["T0"].iloc[0]), T="T_fe", dmu="dmu_sig0").set_index(
+            "fit")
+    return out
 
 
 def estimator_summary(runs, truth):
-    print("\n## 4. The paper's estimator on the model's thermal runs (T_fe, T0 = 1 / nu): per interface and n, "
+    print("\n## 5. The paper's estimator on the model's thermal runs (T_fe, T0 = 1 / nu): per interface and n, "
           "per interface pooled over n, all pooled")
     slips = estimator_runs(runs)
     if slips.empty:
@@ -204,41 +218,46 @@ def estimator_summary(runs, truth):
             print(f"- {setting}, {where} ({row.fit}): B = {fmt(row.B, row.B_error, 4)} [{row.B_low:.4f}, "
                   f"{row.B_high:.4f}], c = {fmt(row.c, row.c_error, 3)}; {row.slips} slips, {row.bins} bins, "
                   f"std(ln T) {row.std_lnT:.2f}, {row.decades:.2f} decades" + (f" ({row.reason})" if row.reason else ""))
+    print("\n## 5b. The estimate (pooled) against the true B (section 4, n = 1), and after subtracting the aging-off "
+          "control (lambda 0, same T)")
+    pooled = pooled_estimates(runs)
+    for (T, lam), table in sorted(pooled.items()):
+        true = truth_at(truth, lam, T)
+        control = pooled.get((T, 0.0))
+        for fit, row in table.iterrows():
+            line = f"- T {T:g}, lambda {lam:g} ({fit}): B = {fmt(row.B, row.B_error, 4)}"
+            if control is not None and lam != 0.0:
+                off = control.loc[fit]
+                line += f"; minus the control: {fmt(row.B - off.B, math.hypot(row.B_error, off.B_error), 4)}"
+            if true is not None:
+                line += f"; true B {fmt(true[0], true[1], 4)} ({true[2]} states)"
+                if lam != 0.0 and true[0] > 0:
+                    line += f": estimate / true {fmt(*ratio(row.B, row.B_error, true[0], true[1]), 2)}"
+            print(line)
 
 
 def requirements_summary(runs, truth):
-    print("\n## 6. What a measurement of B needs for 25 % (the estimator's standard error and its biases)")
-    slips = estimator_runs(runs)
-    for setting, group in slips.groupby("setting"):
-        single = group[~group["multi"].astype(bool) & np.isfinite(group["T_fe"])]
-        if len(single) < 10:
+    print("\n## 6. What the estimator would need to be right within 25 % (pooled fits, section 5b)")
+    pooled = pooled_estimates(runs)
+    for (T, lam), table in sorted(pooled.items()):
+        true = truth_at(truth, lam, T)
+        control = pooled.get((T, 0.0))
+        if lam == 0.0 or true is None or not true[0] > 0 or control is None:
             continue
-        one = single[single["n"] == 1]
-        drop, spread_drop = float(one["dmu_sig0"].mean()), float(one["dmu_sig0"].std(ddof=1))
-        logs = np.log(single["T_fe"] / float(group["T0"].iloc[0]))
-        lam = float(setting.split("lambda ")[1]) if "lambda" in setting else math.nan
-        true = truth.get((1, lam, float(setting.split("T ")[1].split()[0]), 0.1, 1)) if "T " in setting else None
-        if true is None or not np.isfinite(true[0]) or true[0] <= 0:
-            print(f"- {setting}: no true B > 0 to aim at")
-            continue
-        B = true[0]
-        cv = spread_drop / drop
-        need_var = drop * cv**2 / (0.25 * B)
-        print(f"- {setting}: true B {B:.4f} sig0, n = 1 drop {drop:.3f} ± std {spread_drop:.3f} (CV {cv:.2f}); "
-              f"the slips' std(ln T) {logs.std():.2f}: disorder-law bias of the free intercept "
-              f"{biases(gap=0, drop=drop, disorder=cv, std_lnT=logs.std(), mean_ln=logs.mean())['intercept']:.4f}"
-              f" = {biases(gap=0, drop=drop, disorder=cv, std_lnT=logs.std(), mean_ln=logs.mean())['intercept'] / B:.0f}"
-              f" B; below 25 % of B it needs std(ln T) > {math.sqrt(need_var):.1f}; then "
-              f"{slips_needed(B=B, residual=spread_drop, std_lnT=math.sqrt(need_var)):.0f} slips for a standard error "
-              f"of 25 %")
-    # the lab, with the paper's numbers and the twin's widths
-    print("- the lab (the paper's B = 0.053, drops ~0.2, n = 1 widths CV ~ 0.1 (the twin's path disorder: 5-8 %), "
-          "std(ln T) ~1.3): disorder-law bias of the free intercept "
-          f"{biases(gap=0, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['intercept']:.4f} "
+        for fit, row in table.iterrows():
+            bias = control.loc[fit]
+            needed = row.slips * (row.B_error / (0.25 * true[0])) ** 2
+            print(f"- T {T:g}, lambda {lam:g} ({fit}): the aging-off control reads {fmt(bias.B, bias.B_error, 4)} = "
+                  f"{bias.B / true[0]:.2f} of the true B {true[0]:.4f} (bias; within 25 % if below 0.25); standard error "
+                  f"{row.B_error / true[0]:.2f} of it from {row.slips} slips over std(ln T) {row.std_lnT:.2f} "
+                  f"({row.decades:.1f} decades): {needed:.0f} slips for 25 %")
+    print("- the synthetic construction (stickslip.statistics.estimator.biases) at the lab's numbers (the paper's B = "
+          "0.053, drops ~0.2, thresholds' CV ~0.1, std(ln T) ~1.3, <ln T / T0> ~4.6): disorder-law bias of the free "
+          f"intercept {biases(gap=0, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['intercept']:.4f} "
           f"({biases(gap=0, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['intercept'] / 0.053:.2f} B); "
-          f"slips for 25 %: {slips_needed(B=0.053, residual=0.03, std_lnT=1.3):.0f} at a scatter of 0.03 about the "
-          f"law; the origin fit's bias gap <x>/<x^2> = {biases(gap=0.04, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['origin']:.4f} "
-          "at the twin's gap c = 0.04")
+          "the origin fit's bias gap <x> / <x^2> at a strength offset c = 0.04 (the twin's): "
+          f"{biases(gap=0.04, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['origin']:.4f} "
+          f"({biases(gap=0.04, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['origin'] / 0.053:.2f} B)")
 
 
 def main(argv=None):
