@@ -18,8 +18,10 @@ outputs and its run files) and prints, each number with the slips, states or run
    ratio to lambda = 5 (does B scale with the junctions' strengthening?);
 5. the paper's estimator on the model's thermal runs (aging on, and the aging-off control) per interface, per n and
    pooled, with the true B of item 4 beside it;
-6. what a measurement needs for 25 %: the slips and the spread of ln T, from the measured scatter, drop and
-   thresholds.
+6. what a measurement needs for 25 %: the estimator's bias (the aging-off control) and the slips for a standard error
+   of 25 % of the true B, from the measured errors;
+7. the cost: CPU and wall time of every simulation (Snakemake's benchmark files) and of the analyses (their logs'
+   progress lines aside, the events jobs have no benchmark file: their sum is the study's wall time minus the runs').
 """
 
 import argparse
@@ -260,6 +262,25 @@ def requirements_summary(runs, truth):
           f"({biases(gap=0.04, drop=0.2, disorder=0.1, std_lnT=1.3, mean_ln=4.6)['origin'] / 0.053:.2f} B)")
 
 
+def cost_summary(study, runs):
+    print("\n## 7. The cost: CPU seconds of every simulation (logs/benchmarks, cpu_time; wall s in brackets)")
+    settings = {Path(row["file"]).stem: (setting_of(row), row["n"]) for _, row in runs.iterrows()}
+    total = 0.0
+    rows = []
+    for path in sorted(Path(study, "logs", "benchmarks", "sim", "fem").glob("*.tsv")):
+        table = pd.read_csv(path, sep="\t")
+        cpu, wall = float(table["cpu_time"].iloc[-1]), float(table["s"].iloc[-1])
+        total += cpu
+        setting, n = settings.get(path.stem, ("?", 0))
+        rows.append((setting, n, path.stem, cpu, wall))
+    for setting, n, run, cpu, wall in sorted(rows):
+        print(f"- {setting}, n = {n} ({run}): {cpu:.0f} CPU-s ({wall:.0f} s)")
+    others = sorted(Path(study, "logs", "benchmarks", "sim").glob("[!f]*/*.tsv"))
+    other = sum(float(pd.read_csv(path, sep="\t")["cpu_time"].iloc[-1]) for path in others)
+    print(f"- fem runs: {total / 60:.0f} CPU-min in {len(rows)} runs; other solvers: {other / 60:.1f} CPU-min in "
+          f"{len(others)} runs (a resumed run counts only the part after its resume)")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("study", help="results directory of the dissonance study (e.g. results/dissonance)")
@@ -273,6 +294,7 @@ def main(argv=None):
     scaling_summary(truth)
     estimator_summary(runs, truth)
     requirements_summary(runs, truth)
+    cost_summary(args.study, runs)
 
 
 if __name__ == "__main__":
