@@ -141,6 +141,14 @@ QUANTITIES = {
     "dgamma": _q("float64", "gamma0", "lever rotation since the interface's previous slip (numerical)"),
     "hold": _q("float64", "time", "part of T_fe during which the drive was held (numerical)"),
     "mu_before_sig0": _q("float64", "sig0", "the interface's stress before the slip, its peak (numerical)"),
+    "wait_drive": _q("float64", "eps0", "imposed drive since the interface's previous slip (numerical): the "
+                                        "waiting time in units of 1/drive_rate"),
+    "rise_sig0": _q("float64", "sig0", "rise of the interface's stress in the load steps since its previous slip "
+                                       "(numerical)"),
+    "recovered_sig0": _q("float64", "sig0", "the peak minus the stress the interface's previous slip left "
+                                            "(numerical)"),
+    "interrupted_sig0": _q("float64", "sig0", "stress the interface lost in other events since its previous slip "
+                                              "(numerical)"),
     # --- periodicity of a run's slip events (table periodicity, database table ``run_periodicity``)
     "n_slips": _q("int64", "1", "number of slips (steady-state slip events of a run; of an interface)"),
     "n_multi": _q("int64", "1", "number of multi-slips (s > 1; of an interface: its slips in multi-slips)"),

@@ -3,5 +3,6 @@
 Each module is one test or fit with its resolution or confidence interval, on samples that the analyses of
 :mod:`stickslip.events` and :mod:`stickslip.experiment` produce: :mod:`.mean_shift` (a two-sample shift of the
 mean and the smallest shift detectable), :mod:`.sample_comparison` (two runs' slip statistics compared),
-:mod:`.omori` (the Omori-Utsu law fitted by maximum likelihood, bootstrapped over mainshocks).
+:mod:`.omori` (the Omori-Utsu law fitted by maximum likelihood, bootstrapped over mainshocks), :mod:`.estimator`
+(the paper's estimator of the aging rate, Delta mu against ln T, with confidence intervals and its biases).
 """

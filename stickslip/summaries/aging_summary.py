@@ -108,8 +108,8 @@ def first_peaks(item, slip=1):
     return chosen.merge(holds[["trial", "state", "hold_time", "below", "mu_start", "failed_in_hold"]], on="trial")
 
 
-def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3):
-    """Per state (and load, interface), the least-squares slope of ``column`` against ``ln(hold_time)``; their mean.
+def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3, time="hold_time"):
+    """Per state (and load, interface), the least-squares slope of ``column`` against ``ln(time)``; their mean.
 
     Parameters
     ----------
@@ -119,18 +119,21 @@ def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3):
     t_min : float
         Smallest hold time fitted [time] (shorter holds are shorter than the reload to the peak).
     min_points : int
+    time : str
+        The time of the logarithm: ``hold_time`` (T_w), or a column of the contacts' age at the peak
+        (:func:`stickslip.summaries.dissonance_summary.peak_ages`).
 
     Returns
     -------
     tuple[float, float, int]
-        Mean slope [unit of ``column`` per e-fold of T_w], its standard error over the states, states.
+        Mean slope [unit of ``column`` per e-fold of the time], its standard error over the states, states.
     """
     chosen = peaks[(peaks["hold_time"] >= t_min) & ~peaks["failed_in_hold"].astype(bool)]
     keys = [key for key in ("run", "state", "below", "interface") if key in chosen]
     slopes = []
     for _, group in chosen.groupby(keys):
         values = group[column].to_numpy(dtype=float)
-        x = np.log(group["hold_time"].to_numpy(dtype=float))
+        x = np.log(group[time].to_numpy(dtype=float))
         ok = np.isfinite(values)
         if ok.sum() >= min_points and np.ptp(x[ok]) > 0:
             slopes.append(np.polyfit(x[ok], values[ok], 1)[0])
