@@ -148,7 +148,7 @@ def _estimator_panel(ax, slips):
     ax.set_xscale("log")
     ax.set_xlabel(r"$T_a / T_0$")
     ax.set_ylabel(r"$\Delta\mu_a$ [$\sigma_0$]")
-    ax.set_title("the paper's estimator (dashed: origin, solid: intercept)", fontsize=8)
+    ax.set_title("estimator: dashed origin, solid intercept", fontsize=8)
     legend_outside(ax)
 
 
