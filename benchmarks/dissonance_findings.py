@@ -16,8 +16,9 @@ outputs and its run files) and prints, each number with the slips, states or run
 4. the true B: paired holds at a load where no hold fails, the first peak after the hold against the contacts' age
    at the peak (reload included) and against the hold time, per lambda and per interface in the stacks, and its
    ratio to lambda = 5 (does B scale with the junctions' strengthening?);
-5. the paper's estimator on the model's thermal runs (aging on, and the aging-off control) per interface, per n and
-   pooled, with the true B of item 4 beside it;
+5. the thermal runs' waiting times (the re-slips soon after a slip and the slips after a reload), and the paper's
+   estimator on them (aging on, and the aging-off control) per interface, per n and pooled, with the true B of item 4
+   beside it;
 6. what a measurement needs for 25 %: the estimator's bias (the aging-off control) and the slips for a standard error
    of 25 % of the true B, from the measured errors;
 7. the cost: CPU and wall time of every simulation (Snakemake's benchmark files) and of the analyses (their logs'
@@ -35,9 +36,9 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from stickslip.summaries.aging_summary import (curvature, first_peaks, load_aging_runs, mean_sem, paired_slopes, ratio,
-                                            select_runs)
-from stickslip.summaries.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
+from stickslip.summaries.aging_summary import curvature, load_aging_runs, mean_sem, paired_slopes, ratio
+from stickslip.events.waiting_times import spread
+from stickslip.summaries.dissonance_summary import (estimator_runs, hold_peaks, load_runs, loading_rates, scan_table,
                                                  setting_of)
 from stickslip.statistics.estimator import biases, estimator_table
 from stickslip.figures.experimental_data import load_slips
@@ -78,7 +79,8 @@ def scan_summary(runs):
         print(f"- {row.setting}, n = {row.n}, a = {row.interface}: {fmt(row.std_lnT, row.std_lnT_error)} "
               f"({row.n_slips} slips; 5-95 % over {row.decades:.2f} decades; median {row.median_T:.3f} eps0); "
               f"thresholds alone std(ln recovered) {row.std_ln_recovered:.3f}; interrupted share "
-              f"{row.interrupted_share:.2f}")
+              f"{row.interrupted_share:.2f}; median drop {row.median_dmu_sig0:.3f}, std of the peaks "
+              f"{row.std_peak_sig0:.3f} sig0")
     print("- pooled over n (one clock, the drive):")
     for row in pooled.itertuples():
         verdict = "reaches" if row.std_lnT - 2 * row.std_lnT_error >= TARGET else (
@@ -103,9 +105,11 @@ def twin_summary(study):
     slips["pair"] = [_pair(f) for f in slips["file"]]
     for pair, group in slips.groupby("pair"):
         print(f"- rs_a, rs_b = {pair}: {group['file'].nunique()} runs, {len(group)} slips")
-        table = _twin_spread(group)
-        for row in table.itertuples():
-            print(f"  spread a = {row.interface}, n = {row.n}: {fmt(row.std, row.error)} ({row.slips} slips)")
+        for by in (("interface", "n"), ("interface",)):  # per n, then pooled over n (printed as n = 0)
+            for key, part in group.groupby(list(by)):
+                std, error, count = spread(part["T"])
+                a, n = (key if len(by) == 2 else (key[0] if isinstance(key, tuple) else key, 0))
+                print(f"  spread a = {a}, n = {n}: {fmt(std, error)} ({count} slips)")
         fits = estimator_table(group, t0=1.0, by=("interface",), T="T", dmu="dmu")
         for row in fits.itertuples():
             b = group.loc[group["interface"] == row.interface, "b"].mean()
@@ -126,27 +130,6 @@ def _pair(path):
     return (tuple(params.get("rs_a", ())), tuple(params.get("rs_b", ())))
 
 
-def _twin_spread(slips):
-    rows = []
-    for (a, n), group in list(slips.groupby(["interface", "n"])) + [((a, 0), g) for a, g in slips.groupby("interface")]:
-        T = group["T"].to_numpy(dtype=float)
-        logs = np.log(T[np.isfinite(T) & (T > 0)])
-        std = logs.std(ddof=1) if logs.size > 1 else math.nan
-        rows.append({"interface": a, "n": n, "std": std, "error": std / math.sqrt(2 * max(logs.size - 1, 1)),
-                     "slips": logs.size})
-    return pd.DataFrame(rows)
-
-
-def true_peaks(runs):
-    """The first peak of every interface after every hold of the runs, with the contacts' age at the peak."""
-    parts = []
-    for k, item in enumerate(runs["data"]):
-        peaks = first_peaks(item)
-        if len(peaks):
-            parts.append(peak_ages(peaks, item.tables["slip_events"]).assign(run=k))
-    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
-
-
 def true_summary(study):
     """Item 4: the true B of the paired holds, per setting; returns {(n, lambda, T, interface): (B, error, states)}."""
     print("\n## 4. The true B: paired holds, first peak after the hold against ln(age at the peak) (hold + reload) "
@@ -156,7 +139,7 @@ def true_summary(study):
         every = load_aging_runs(sorted(glob.glob(str(Path(study) / "events" / analysis / "fem" / "*.h5"))))
         every = every[every["trials"] == every["n"]]
         for (n, lam, T, rate), runs in every.groupby(["n", "strengthening", "temperature", "drive_rate"]):
-            peaks = true_peaks(runs)
+            peaks = hold_peaks(runs["data"])
             if peaks.empty:
                 continue
             for below, part in peaks.groupby("below") if "below" in peaks else [(0.02, peaks)]:
@@ -203,7 +186,22 @@ def pooled_estimates(runs):
     return out
 
 
-def estimator_summary(runs, truth):
+def thermal_waits_summary(runs):
+    print("\n## 5a. The thermal runs' waiting times: T_fe / T0 of every slip, the re-slips soon after a slip "
+          "(T < 1e6 T0) and the slips after a reload (T >= 1e7 T0)")
+    slips = estimator_runs(runs)
+    for setting, group in slips.groupby("setting"):
+        T = group["T_fe"].to_numpy(dtype=float) / group["T0"].to_numpy(dtype=float)
+        ok = np.isfinite(T) & (T > 0)
+        std, error, count = spread(T)
+        short, long = ok & (T < 1e6), ok & (T >= 1e7)
+        drops = group["dmu_sig0"].to_numpy(dtype=float)
+        print(f"- {setting}: {count} slips, std(ln T) {fmt(std, error, 2)}, median T {np.median(T[ok]):.2g} T0; "
+              f"T < 1e6 T0: {short.sum() / ok.sum():.2f} of them, median drop {np.median(drops[short]):.3f} sig0; "
+              f"T >= 1e7 T0: median drop {np.median(drops[long]):.3f} sig0")
+
+
+def estimator_summary(runs, truth, pooled):
     print("\n## 5. The paper's estimator on the model's thermal runs (T_fe, T0 = 1 / nu): per interface and n, "
           "per interface pooled over n, all pooled")
     slips = estimator_runs(runs)
@@ -222,7 +220,6 @@ def estimator_summary(runs, truth):
                   f"std(ln T) {row.std_lnT:.2f}, {row.decades:.2f} decades" + (f" ({row.reason})" if row.reason else ""))
     print("\n## 5b. The estimate (pooled) against the true B (section 4, n = 1), and after subtracting the aging-off "
           "control (lambda 0, same T)")
-    pooled = pooled_estimates(runs)
     for (T, lam), table in sorted(pooled.items()):
         true = truth_at(truth, lam, T)
         control = pooled.get((T, 0.0))
@@ -238,9 +235,8 @@ def estimator_summary(runs, truth):
             print(line)
 
 
-def requirements_summary(runs, truth):
+def requirements_summary(truth, pooled):
     print("\n## 6. What the estimator would need to be right within 25 % (pooled fits, section 5b)")
-    pooled = pooled_estimates(runs)
     for (T, lam), table in sorted(pooled.items()):
         true = truth_at(truth, lam, T)
         control = pooled.get((T, 0.0))
@@ -292,8 +288,10 @@ def main(argv=None):
     twin_summary(args.study)
     truth = true_summary(args.study)
     scaling_summary(truth)
-    estimator_summary(runs, truth)
-    requirements_summary(runs, truth)
+    pooled = pooled_estimates(runs)
+    thermal_waits_summary(runs)
+    estimator_summary(runs, truth, pooled)
+    requirements_summary(truth, pooled)
     cost_summary(args.study, runs)
 
 

@@ -20,11 +20,10 @@ and, if the study has them, its ``thermal-events`` outputs with hold trials:
 import dataclasses
 
 import numpy as np
-import pandas as pd
 
 from .. import registry
-from ..summaries.aging_summary import first_peaks, load_aging_runs, paired_slopes
-from ..summaries.dissonance_summary import (estimator_runs, load_runs, loading_rates, peak_ages, scan_table,
+from ..summaries.aging_summary import load_aging_runs, paired_slopes
+from ..summaries.dissonance_summary import (estimator_runs, hold_peaks, load_runs, loading_rates, scan_table,
                                          setting_of)
 from ..statistics.estimator import estimate
 from ..experiment.aging import log_binned
@@ -160,8 +159,9 @@ def _truth_panel(ax, thermal, estimates):
     runs = thermal[(thermal["n"] == 1) & (thermal["trials"] == 1)]
     curves = {}  # (T, below) -> [(lambda, B, error)]
     for (T, lam), group in runs.groupby(["temperature", "strengthening"]):
-        peaks = pd.concat([peak_ages(first_peaks(item), item.tables["slip_events"]).assign(run=k)
-                           for k, item in enumerate(group["data"])], ignore_index=True)
+        peaks = hold_peaks(group["data"])
+        if peaks.empty:
+            continue
         for below, held in peaks.groupby("below"):
             slope, error, states = paired_slopes(held, t_min=0.0, time="age")
             if states:

@@ -11,7 +11,8 @@ dissonance").
   linear response), [sig0 per eps0 of drive]: in the lab ``K h gamma_dot (n + a)(n - a + 1) / (2 N)``.
 - :func:`peak_ages`: the hold trials' peaks (:func:`.aging_summary.first_peaks`) with the age of the slipping
   interface's contacts at its peak: the time since the hold's start (hold and reload) plus the time between the
-  interface's last slip and the state held (0 for the interface whose slip the state is).
+  interface's last slip and the state held (0 for the interface whose slip the state is); :func:`hold_peaks`: the
+  same for several runs.
 - :func:`estimator_runs`: the single slips of thermal runs with their waiting time ``T_fe`` and drop, ready for
   :func:`stickslip.statistics.estimator.estimator_table`.
 """
@@ -23,8 +24,9 @@ import pandas as pd
 from ..formats.analysis_file import open_analysis_file
 from ..events.analysis_files import read_analysis_file
 from ..events.waiting_times import spread_table
+from .aging_summary import first_peaks
 
-__all__ = ["load_runs", "setting_of", "scan_table", "interface_rates", "loading_rates", "peak_ages", "estimator_runs", "SETTING_KEYS"]
+__all__ = ["load_runs", "setting_of", "scan_table", "interface_rates", "loading_rates", "peak_ages", "hold_peaks", "estimator_runs", "SETTING_KEYS"]
 
 #: Columns of :func:`load_runs` that make a drive setting.
 SETTING_KEYS = ("drive", "lever_height", "k_drive", "temperature", "drive_rate", "strengthening")
@@ -81,7 +83,8 @@ def scan_table(runs):
     -------
     tuple[pandas.DataFrame, pandas.DataFrame]
         Per (``setting``, ``n``, ``interface``) and per (``setting``, ``interface``) pooled over ``n`` and seeds:
-        :func:`stickslip.events.waiting_times.spread_table`'s columns (of ``T_fe`` in thermal runs, ``wait_drive`` else).
+        :func:`stickslip.events.waiting_times.spread_table`'s columns (of ``T_fe`` in thermal runs, ``wait_drive`` else),
+        then ``median_dmu_sig0`` (the median drop) and ``std_peak_sig0`` (the standard deviation of the peaks) [sig0].
     """
     parts = []
     for _, run in runs.iterrows():
@@ -90,10 +93,16 @@ def scan_table(runs):
                                   T=slips["T_fe"] if run["thermal"] else slips["wait_drive"]))
     if not parts:
         parts = [pd.DataFrame(columns=["setting", "n", "interface", "T", "rise_sig0", "recovered_sig0",
-                                       "interrupted_sig0"])]
+                                       "interrupted_sig0", "dmu_sig0", "mu_before_sig0"])]
     slips = pd.concat(parts, ignore_index=True)
-    return (spread_table(slips, ("setting", "n", "interface"), T="T"),
-            spread_table(slips, ("setting", "interface"), T="T"))
+    return tuple(_with_drops(spread_table(slips, by, T="T"), slips, by)
+                 for by in (("setting", "n", "interface"), ("setting", "interface")))
+
+
+def _with_drops(table, slips, by):
+    """``table`` with the median drop ``median_dmu_sig0`` and the peaks' spread ``std_peak_sig0`` per group."""
+    drops = slips.groupby(list(by)).agg(median_dmu_sig0=("dmu_sig0", "median"), std_peak_sig0=("mu_before_sig0", "std"))
+    return table.merge(drops.reset_index(), on=list(by), how="left")
 
 
 def interface_rates(delta_eps, delta_target, delta_lever, top_height, eps0, free_lever):
@@ -174,6 +183,28 @@ def peak_ages(peaks, slips):
             now = slips.loc[slips["increment"] == state, "t"]
             start[k] = float(now.iloc[0]) - float(last["t"]) if len(now) else np.nan
     return peaks.assign(age_start=start, age=start + peaks["t"].to_numpy(dtype=float))
+
+
+def hold_peaks(items):
+    """:func:`peak_ages` of the first peaks after every hold of several runs, one frame.
+
+    Parameters
+    ----------
+    items : Iterable[stickslip.events.analysis_files.AnalysisFile]
+        ``thermal-events`` outputs with the tables ``slip_events``, ``holds`` and ``trial_slips``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`peak_ages` rows of every run with hold trials, with ``run`` (the run's index in ``items``); empty if
+        none has any.
+    """
+    parts = []
+    for k, item in enumerate(items):
+        peaks = first_peaks(item)
+        if len(peaks):
+            parts.append(peak_ages(peaks, item.tables["slip_events"]).assign(run=k))
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
 
 
 def estimator_runs(runs):
