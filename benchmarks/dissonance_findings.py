@@ -155,7 +155,9 @@ def true_summary(study):
                           f"curvature in ln age {fmt(*bend, 5)}; age at the peak without a hold "
                           f"{reload[0]:.3g} ± {reload[1]:.2g}; failed in the hold "
                           f"{held['failed_in_hold'].mean():.2f} of {len(held)} holds; held stress "
-                          f"{held['mu_start'].mean():.3f} sig0")
+                          f"{held['mu_start'].mean():.3f} sig0, {held['held_below'].mean():.2f} eps0 under the "
+                          f"threshold (least {held['held_below'].min():.2f}; "
+                          f"{(held['held_below'] < below * (1 - 1e-9)).mean():.2f} of the holds short of {below:g})")
                     truth[(n, lam, T, below, a)] = age
     return truth
 

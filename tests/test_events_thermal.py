@@ -19,6 +19,7 @@ from stickslip.formats.fem_run import read_increments
 from stickslip.figures import figs_thermal
 from stickslip.figures.experimental_data import EVENTS
 from stickslip.figures.style import plt
+from stickslip.fem.thermal.protocol import drive_scale
 from stickslip.h5io import open_file, read_table
 from stickslip.lineage import Artifact
 from stickslip.plugin_params import parse_params
@@ -196,3 +197,47 @@ def test_the_figure_plots_the_numbers_of_its_runs(study):
     np.testing.assert_array_equal(means.get_xdata(), table["hold_time"].to_numpy())
     np.testing.assert_array_equal(means.get_ydata(), table["mean"].to_numpy())
     plt.close(figure)
+
+
+def test_an_elastic_unload_stops_at_the_first_block_that_would_leave_its_well(study):
+    """Loading.unload_size: the unload it gives keeps every well index; where it is capped, a step 1e-4 further
+    changes one (the bisection's tolerance is 1e-5)."""
+    replay = registry.replay("fem", study[figs_thermal.THERMAL][0].parent.path)
+    simulation = replay.simulation
+    increments = read_increments(replay.path)
+    capped = 0
+    for increment in increments["increment"].to_numpy()[increments["kick"].to_numpy()][:20]:
+        state = replay._state(int(increment))
+        simulation.stack.restore(*state)
+        wells = simulation.stack.well_index()
+        wanted = 100.0 * simulation.loading.step_size(False) + 1.0
+        unload = simulation.loading.unload_size(wanted)
+        assert 0.0 <= unload <= wanted
+        simulation.loading.load(-unload)
+        assert np.array_equal(simulation.stack.well_index(), wells)
+        if unload < wanted:
+            capped += 1
+            simulation.stack.restore(*state)
+            simulation.loading.load(-unload * (1.0 + 1e-4))
+            assert not np.array_equal(simulation.stack.well_index(), wells)
+    assert capped > 0
+
+
+def test_a_hold_unloads_a_state_nearer_its_threshold_than_below(study):
+    """A state ``d`` eps0 of drive under its threshold held at ``below = d + 0.1, 0.3, 0.5``: each hold says it
+    reached its ``below``, and the held stresses are those of an elastic unload (linear in ``below``: their
+    differences in the ratio 0.2 : 0.4). A hold that could not unload would start all three at the state's load."""
+    replay = registry.replay("fem", study[figs_thermal.THERMAL][0].parent.path)
+    simulation = replay.simulation
+    slips = _tables(study[figs_thermal.THERMAL][0])["slip_events"]
+    state = int(slips["increment"].iloc[len(slips) // 2])
+    simulation.stack.restore(*replay._state(state))
+    scale = drive_scale(simulation.loading.response, simulation.params.eps0, simulation.mesh)
+    near = simulation.loading.step_size(False) * scale
+    assert simulation.loading.unload_size(0.5 / scale) == 0.5 / scale  # the unloads below are not capped
+    trials = [replay.hold(state, 0.0, near + extra, 0) for extra in (0.1, 0.3, 0.5)]
+    np.testing.assert_allclose([trial["held_below"] for trial in trials], near + np.array([0.1, 0.3, 0.5]),
+                               rtol=1e-12)
+    start = np.array([trial["mu_start"] for trial in trials])
+    assert start[0] > start[1] > start[2]
+    np.testing.assert_allclose((start[0] - start[1]) / (start[0] - start[2]), 0.2 / 0.4, rtol=1e-6)

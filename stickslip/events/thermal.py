@@ -33,7 +33,8 @@ experiment done on its stored states:
 Output (format ``event-table``): ``slip_events`` (the normalised table; further columns ``T_fe``,
 ``hold``, ``B_a_sig0``, ``mu_before_sig0``, ``dgamma``), ``interfaces`` (``interface``, ``R_tot``, ``dR_sum`` [well hops],
 ``R_slow``, ``n_slips``), ``holds`` (one row per trial: ``trial``, ``state`` (increment), ``replica``,
-``hold_time``, ``peak``, ``interface``, ``mu_start`` [sig0], ``failed_in_hold``, ``t_slip``,
+``hold_time``, ``held_below`` [eps0] (the hold's load under the threshold: ``below``, or less where unloading
+to it would move a block out of its well), ``peak``, ``interface``, ``mu_start`` [sig0], ``failed_in_hold``, ``t_slip``,
 ``hold_hops``, ``events``), ``creep`` (``trial``, ``t`` since the hold's start, ``R_<a>`` the slip of
 interface a since then [well hops], after each hop within a hold), ``barriers`` (``trial``, ``block``,
 ``start``, ``end``: every block's forward barrier at the start and end of the hold, in units of the
@@ -62,7 +63,8 @@ from .plugin import event_attrs
 __all__ = ["ThermalEventParams", "NAME", "VERSION", "slip_table", "interface_table", "hold_tables", "run"]
 
 NAME = "thermal-events"
-VERSION = "2"  # 2: the package's vocabulary (dmu_sig0, t, T_fe, B_a_sig0, mu_before_sig0, interface; event-table 2)
+VERSION = "3"  # 2: the package's vocabulary (dmu_sig0, t, T_fe, B_a_sig0, mu_before_sig0, interface; event-table 2);
+#             3: holds unload to ``below`` where a state is nearer its threshold (column held_below)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -195,7 +197,7 @@ def hold_tables(hold, states, params, T0, n_interfaces, results=None):
                 results.append(result)
             holds.append({"trial": trial, "state": int(state), "replica": replica, "hold_time": hold_time * T0,
                           **({"below": below} if params.hold_loads else {}),
-                          **{k: result[k] for k in ("peak", "interface", "mu_start", "failed_in_hold", "t_slip",
+                          **{k: result[k] for k in ("held_below", "peak", "interface", "mu_start", "failed_in_hold", "t_slip",
                                                     "hold_hops", "events")}})
             rows = result["creep"]
             creep.append(pd.DataFrame({"trial": np.full(len(rows), trial), "t": rows[:, 0],
@@ -205,7 +207,7 @@ def hold_tables(hold, states, params, T0, n_interfaces, results=None):
                                           "start": result["barriers_start"], "end": result["barriers_end"]}))
             bar.update(1)
     bar.close()
-    columns = ["trial", "state", "replica", "hold_time", *(["below"] if params.hold_loads else []), "peak",
+    columns = ["trial", "state", "replica", "hold_time", *(["below"] if params.hold_loads else []), "held_below", "peak",
                "interface", "mu_start", "failed_in_hold", "t_slip", "hold_hops", "events"]
     holds = pd.DataFrame(holds, columns=columns).astype({"trial": np.int64, "state": np.int64,
                                                          "replica": np.int64, "interface": np.int64,

@@ -21,7 +21,7 @@ from .laws import well_index
 from .materials import equivalent_strain
 from .quad4 import element_strain
 
-__all__ = ["step_size", "autoscale", "BISECTION_RTOL", "MAX_BISECTIONS"]
+__all__ = ["step_size", "unload_size", "autoscale", "BISECTION_RTOL", "MAX_BISECTIONS"]
 
 #: Relative width at which the bisection stops.
 BISECTION_RTOL = 1e-5
@@ -125,6 +125,41 @@ def step_size(epsy, dofs, dNdx, u, du, eps, deps, idx, deps_kick, kick, yield_el
         if (right - left) / left < BISECTION_RTOL:
             break
     return right if kick else left
+
+
+@njit
+def unload_size(epsy, dofs, dNdx, u, du, idx, step):
+    """Largest step back along the linear response, at most ``step``, that changes no well index.
+
+    An elastic unload: ``u - s du`` for ``s`` up to ``step`` while every Gauss point stays in its
+    well (the backward twin of an elastic load step, without its ``deps_kick / 2`` margin); bisected
+    to ``(right - left) < BISECTION_RTOL * right`` where a point would leave its well before ``step``.
+
+    Parameters
+    ----------
+    epsy, dofs, dNdx, u, du, idx
+        As :func:`step_size`.
+    step : float
+        The unload wanted (>= 0) [in units of the linear response].
+
+    Returns
+    -------
+    float
+        The unload ``s`` (0 <= s <= step); ``u - s du`` has the well indices ``idx``.
+    """
+    back = -du
+    if not _yields(epsy, dofs, dNdx, u, back, idx, step, False):
+        return step
+    left, right = 0.0, step
+    for _ in range(MAX_BISECTIONS):
+        mid = 0.5 * (right + left)
+        if _yields(epsy, dofs, dNdx, u, back, idx, mid, False):
+            right = mid
+        else:
+            left = mid
+        if right - left < BISECTION_RTOL * right:
+            break
+    return left
 
 
 @njit

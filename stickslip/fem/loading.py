@@ -8,7 +8,7 @@ Reference: shared/reference-model.md, section 8a-8b.
 """
 
 from .errors import SolverError
-from .event_driven import step_size
+from .event_driven import step_size, unload_size
 
 __all__ = ["Loading", "KickAlongResponse"]
 
@@ -64,6 +64,23 @@ class Loading:
         if step < 0.0:
             raise SolverError("no step along the linear response makes a block yield")
         return step
+
+    def unload_size(self, step):
+        """The largest elastic step back along the linear response, at most ``step`` (nothing is changed).
+
+        Parameters
+        ----------
+        step : float
+            The unload wanted (>= 0) [in units of the linear response].
+
+        Returns
+        -------
+        float
+            ``s`` in ``[0, step]`` such that ``load(-s)`` changes no well index (:func:`.event_driven.unload_size`).
+        """
+        m, stack = self.model, self.stack
+        u, idx = stack.read("u", "idx")
+        return unload_size(stack.yield_strains, m.iface_dofs, m.iface_dNdx, u, self.response.delta_u, idx, step)
 
     def load(self, step):
         """Move the state by ``step`` along the linear response (displacement and drive; no dynamics)."""

@@ -96,16 +96,19 @@ def first_peaks(item, slip=1):
     Returns
     -------
     pandas.DataFrame
-        ``state``, ``hold_time``, ``below``, ``interface``, ``peak`` [sig0], ``widening`` [eps0],
-        ``precursors``, ``mu_start`` (the trial's held stress of its first slipping interface), ``failed_in_hold``.
+        ``state``, ``hold_time``, ``below``, ``held_below`` (the load reached, [eps0] under the threshold: ``below``
+        where the file predates the column), ``interface``, ``peak`` [sig0], ``widening`` [eps0], ``precursors``,
+        ``mu_start`` (the trial's held stress of its first slipping interface), ``failed_in_hold``.
     """
     holds, slips = item.tables["holds"], item.tables.get("trial_slips")
     if slips is None or holds.empty:
-        return pd.DataFrame(columns=["state", "hold_time", "below", "interface", "peak", "widening", "precursors",
-                                     "mu_start", "failed_in_hold"])
+        return pd.DataFrame(columns=["state", "hold_time", "below", "held_below", "interface", "peak", "widening",
+                                     "precursors", "mu_start", "failed_in_hold"])
     holds = holds if "below" in holds else holds.assign(below=float(item.attrs["analysis_params"].get("below", 0.02)))
+    holds = holds if "held_below" in holds else holds.assign(held_below=holds["below"])
     chosen = slips[slips["slip"] == slip]
-    return chosen.merge(holds[["trial", "state", "hold_time", "below", "mu_start", "failed_in_hold"]], on="trial")
+    return chosen.merge(holds[["trial", "state", "hold_time", "below", "held_below", "mu_start", "failed_in_hold"]],
+                        on="trial")
 
 
 def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3, time="hold_time"):

@@ -3,7 +3,10 @@
 The slide-hold-slide experiment done on the states of a run, paired: every trial starts from the
 same stored state, so that the hold time is the only difference between trials of that state.
 From a stored state the load is brought (an elastic step along the linear response) to ``below``
-[eps0 of imposed shear] under the state's athermal threshold; the drive is held there for
+[eps0 of imposed shear] under the state's athermal threshold: a step forward where the state is
+farther from it, an elastic unload where it is nearer (as the state a slip leaves often is at a soft
+drive), as far as no block leaves its well (then the hold is nearer than ``below``, and the trial says
+how near: ``held_below``); the drive is held there for
 ``hold_time`` while the blocks hop (creep); then it is driven on at the run's drive rate until the
 next slip event (every block of some interface in another well), which may also come during the
 hold (delayed failure). The trial records the peak stress of the slipping interface (its stress at
@@ -82,7 +85,9 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
     Returns
     -------
     dict
-        ``t0`` (time at the hold's start), ``peak`` [sig0] and ``interface`` (lowest slipping one; NaN and
+        ``t0`` (time at the hold's start), ``held_below`` (the imposed shear between the hold's load and the
+        athermal threshold [eps0]: ``below``, or less where the unload to it would move a block out of its well),
+        ``peak`` [sig0] and ``interface`` (lowest slipping one; NaN and
         0 if no slip came within :data:`MAX_EVENTS` events), ``mu_start`` [sig0] (its stress at the hold's
         start), ``failed_in_hold`` (bool), ``t_slip`` (time from the hold's start to the slip),
         ``hold_hops``, ``events``; ``creep`` (float64 [k, 1 + n]: time since the hold's start and the
@@ -95,8 +100,15 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
     """
     s, p = simulation, simulation.params
     s.stack.restore(*state)
+    scale = drive_scale(s.loading.response, p.eps0, s.mesh)
     ds_c = s.loading.step_size(False)
-    s.loading.load(max(ds_c - below / drive_scale(s.loading.response, p.eps0, s.mesh), 0.0))
+    if ds_c >= below / scale:
+        s.loading.load(ds_c - below / scale)
+        held_below = below
+    else:
+        unload = s.loading.unload_size(below / scale - ds_c)
+        s.loading.load(-unload)
+        held_below = (ds_c + unload) * scale
     observer = Observer(s)
     protocol = thermal_protocol(s.stack, s.model, s.loading, s.relaxation, p, s.mesh, s.constants,
                                 stream=STREAM + REPLICAS * (replica + 1))
@@ -112,7 +124,7 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
     hold_end = previous.copy()
     creep, slips = [], []
     counts = np.zeros(p.plates, dtype=np.int64)
-    result = {"t0": t0, "peak": np.nan, "interface": 0, "mu_start": np.nan, "failed_in_hold": False,
+    result = {"t0": t0, "held_below": held_below, "peak": np.nan, "interface": 0, "mu_start": np.nan, "failed_in_hold": False,
               "t_slip": np.nan, "hold_hops": 0}
     for k in range(1, MAX_EVENTS + 1):
         protocol.step(False, p.margin, 2 * k - 1)
