@@ -16,7 +16,8 @@ holds behind it (standard errors over the states of paired hold trials, pooled o
    and R_slow per interface;
 4. aftershocks: events per interface in the holds after slips and in the controls, Omori-Utsu fits; in the
    driven runs, the time and the drive from a slip to the next event per pair of interfaces at two drive rates;
-5. aging against the hold load: the slope per ``below``, the held stress, the precursors before the peak.
+5. aging against the hold load: the slope per ``below``, the held stress, the precursors before the peak (base);
+   the slope per ``below`` of the other settings and its ratio to the base's at the same load.
 """
 
 import argparse
@@ -33,6 +34,10 @@ from stickslip.experiment.aging import spread_of_aging_rate
 from stickslip.formats.fem_run import read_increments
 
 BASE = {"n": 1, "temperature": 1e-3, "drive_rate": 2e-8, "strengthening": 5.0}
+
+#: The n = 1 settings of the paired holds: the base and the base with lambda or T doubled, or aging off.
+SETTINGS = {"base (lambda 5, T 1e-3)": BASE, "lambda 10": {**BASE, "strengthening": 10.0},
+            "T 2e-3": {**BASE, "temperature": 2e-3}, "aging off": {**BASE, "strengthening": 0.0}}
 
 
 def fmt(value, error, digits=4):
@@ -57,10 +62,8 @@ def runs_summary(runs, study):
 
 def holds_summary(runs):
     print("\n## Paired holds, n = 1 (slope of the first-slip peak in ln T_w, T_w >= 1e6, below = 0.02)")
-    settings = {"base (lambda 5, T 1e-3)": BASE, "lambda 10": {**BASE, "strengthening": 10.0},
-                "T 2e-3": {**BASE, "temperature": 2e-3}, "aging off": {**BASE, "strengthening": 0.0}}
     slopes = {}
-    for name, where in settings.items():
+    for name, where in SETTINGS.items():
         peaks = trial_peaks(select_runs(runs, **where))
         if peaks.empty:
             continue
@@ -94,18 +97,28 @@ def holds_summary(runs):
 
 
 def loads_summary(runs):
-    print("\n## Aging against the hold load (base runs)")
+    print("\n## Aging against the hold load (base runs; then the other settings, their ratio to the base at each load)")
     peaks = trial_peaks(select_runs(runs, **BASE))
     if peaks.empty:
         return
+    base = {}
     for below, part in peaks.groupby("below"):
-        slope, error, states = paired_slopes(part)
+        slope, error, states = base[below] = paired_slopes(part)
         stress = mean_sem(part.drop_duplicates(["run", "state"])["mu_start"])
         held = part["hold_time"] >= 1e6
         print(f"- below {below:g} eps0: held stress {fmt(*stress[:2], 3)} sig0; slope {fmt(slope, error)} ({states} "
               f"states); precursors before the first peak {fmt(*mean_sem(part['precursors'])[:2], 3)} of the blocks "
               f"(holds >= 1e6: {fmt(*mean_sem(part.loc[held, 'precursors'])[:2], 3)}); failed in the hold "
               f"{part.drop_duplicates(['run', 'state', 'hold_time'])['failed_in_hold'].mean():.2f}")
+    for name, where in list(SETTINGS.items())[1:]:
+        others = trial_peaks(select_runs(runs, **where))
+        for below, part in (others.groupby("below") if not others.empty else []):
+            slope, error, states = paired_slopes(part)
+            against = (f"{fmt(*ratio(slope, error, *base[below][:2]), 2)}" if below in base and where["strengthening"]
+                       else "-")
+            print(f"  {name}, below {below:g} eps0: slope {fmt(slope, error)} ({states} states); failed in the hold "
+                  f"{part.drop_duplicates(['run', 'state', 'hold_time'])['failed_in_hold'].mean():.2f}; / base at "
+                  f"this load {against}")
 
 
 def estimator_summary(runs, every):
