@@ -47,6 +47,10 @@ __all__ = ["RESULTS", "PATHS", "study_name", "check_study_name", "SimulationJob"
 #: Directory of the studies' results trees (relative to the workflow's working directory).
 RESULTS = "results"
 
+#: Scheduling priority of an analysis job (rule ``events``): above every run's (:meth:`Study.run_priority`), so that
+#: an analysis starts as soon as its run is stored instead of waiting behind runs that do not need it.
+ANALYSIS_PRIORITY = 2
+
 #: Path patterns inside a study's results tree ``results/{study}/``.
 PATHS = {
     "mesh": "mesh/{mesh_id}.h5",
@@ -517,6 +521,15 @@ class Study:
             if sim.solver == solver and sim.run_id == run_id:
                 return sim
         raise KeyError(f"no simulation {solver}/{run_id} in the study")
+
+    def run_priority(self, solver, run_id):
+        """The scheduling priority of one simulation's job (rule ``simulate``; outputs do not depend on it).
+
+        1 for a run at a finite temperature (a ``temperature`` parameter > 0), whose analyses may replay it (hold
+        trials, aftershocks) for as long as the run took: its chain is the longest and starts first; 0 otherwise.
+        Analyses have :data:`ANALYSIS_PRIORITY`, so that they start as soon as their run is stored.
+        """
+        return int(float(self.simulation(solver, run_id).params.get("temperature") or 0.0) > 0.0)
 
     def solver_inputs(self, solver, run_id):
         """Return the upstream files of one simulation by format (``{"mesh": Artifact}`` or ``{}``)."""

@@ -345,3 +345,12 @@ def test_labelled_keys_make_their_own_jobs(tmp_path, toy_distribution):
                                       "GROUP BY plugin").fetchall()
         params = {row[0] for row in connection.execute("SELECT params FROM runs WHERE kind = 'analysis'")}
     assert analyses == [("toy-slips", 6)] and len(params) == 2
+
+
+def test_thermal_runs_and_then_analyses_come_first_in_the_schedule():
+    from stickslip.study_plan import ANALYSIS_PRIORITY
+
+    study = Study({"solvers": {"fem": [{"params": {"N": 9, "plates": 2}, "grid": {"temperature": [0.0, 1e-3]}}]}})
+    priorities = {sim.params.get("temperature", 0.0): study.run_priority(sim.solver, sim.run_id) for sim in study.simulations}
+    assert priorities == {0.0: 0, 1e-3: 1}
+    assert ANALYSIS_PRIORITY > max(priorities.values())

@@ -12,7 +12,7 @@ from snakemake.utils import validate
 from stickslip.plugin_params import ParameterError, did_you_mean
 from stickslip.provenance.code import code_hash
 from stickslip.provenance.record import record_path
-from stickslip.study_plan import Study, check_sweeps, normalise, plugin_sections
+from stickslip.study_plan import ANALYSIS_PRIORITY, Study, check_sweeps, normalise, plugin_sections
 
 
 def _validate(section, schema, key):

@@ -15,6 +15,7 @@ rule events:
         simulation=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).artifact()),
         code=lambda wildcards: Study.code("analysis", wildcards.analysis),
         module=lambda wildcards: Study.module("analysis", wildcards.analysis),
+    priority: ANALYSIS_PRIORITY
     conda:
         CONDA_ENV
     script:

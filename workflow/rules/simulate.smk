@@ -3,6 +3,7 @@
 # is made by rule simulate_gpu, the same rule asking for a GPU; runs of a GPU batch (config gpu_batch,
 # stickslip.study_plan.device_batches) by one job of their batch's rule, each to its usual file. Every job on a GPU
 # has the resources that a profile sets for simulate_gpu (GPU_RULE, common.smk: a GPU partition, profiles/slurm).
+# Runs at a finite temperature start first (Study.run_priority: their analyses may replay them for as long again).
 
 
 rule simulate:
@@ -16,6 +17,7 @@ rule simulate:
     benchmark:
         STUDY.path("benchmark")
     threads: STUDY.threads
+    priority: lambda wildcards: STUDY.run_priority(wildcards.solver, wildcards.run_id)
     wildcard_constraints:
         run_id=STUDY.single_runs(on_gpu=False),
     params:
