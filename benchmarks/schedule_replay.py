@@ -1,32 +1,33 @@
 """How long a study takes on few cores under a scheduling policy: its jobs' measured times replayed.
 
-    python benchmarks/schedule_replay.py SNAKEMAKE_LOG [--cores 2] [--orders 40]
+    python benchmarks/schedule_replay.py SNAKEMAKE_LOG --configfile CONFIG [--cores 2] [--orders 40]
 
 Reads the start and end of every job from the log of a Snakemake run (``snakemake --cores 2 ... > LOG 2>&1``), then
 replays the jobs on ``--cores`` cores by list scheduling: whenever a core is free, the ready job (its run stored,
 for an analysis; every run and analysis done, for a figure or the database) of the highest priority starts, ties in
 a random order (``--orders`` of them; the order Snakemake took is replayed too). Two policies: no priorities, and
-the workflow's (:meth:`stickslip.study_plan.Study.run_priority`: runs at a finite temperature 1, others 0;
-analyses :data:`stickslip.study_plan.ANALYSIS_PRIORITY`). Prints the measured wall time, the jobs' summed time over
+the workflow's for the study of ``CONFIG`` (:meth:`stickslip.study_plan.Study.run_priority` for a run, analyses
+:data:`stickslip.study_plan.ANALYSIS_PRIORITY`). Prints the measured wall time, the jobs' summed time over
 the cores (no schedule is shorter) and each policy's least, median and largest wall time [min]. The replay assumes
 a job takes as long as it did in the log whatever runs beside it; a meshing job (seconds) is not waited for.
 """
 
 import argparse
 import datetime
-import json
 import random
 import re
 from pathlib import Path
 
-from stickslip.study_plan import ANALYSIS_PRIORITY
+import yaml
+
+from stickslip.study_plan import ANALYSIS_PRIORITY, Study
 
 _STAMP = "%a %b %d %H:%M:%S %Y"
 _GATHERING = ("figure", "database", "all")
 
 
 def read_jobs(log):
-    """The jobs of a Snakemake log: {jobid: {rule, run_id, start, end [datetime]}} (finished jobs only)."""
+    """The jobs of a Snakemake log: {jobid: {rule, solver, run_id, start, end [datetime]}} (finished jobs only)."""
     jobs, current, stamp, rule = {}, None, None, None
     for line in Path(log).read_text().splitlines():
         if line.startswith("[") and line.endswith("]"):
@@ -38,22 +39,12 @@ def read_jobs(log):
             rule = match.group(1)
         elif match := re.match(r"\s+jobid: (\d+)", line):
             current = match.group(1)
-            jobs[current] = {"rule": rule, "run_id": None, "start": stamp}
-        elif (match := re.match(r"\s+wildcards: .*run_id=(\w+)", line)) and current:
-            jobs[current]["run_id"] = match.group(1)
+            jobs[current] = {"rule": rule, "solver": None, "run_id": None, "start": stamp}
+        elif (match := re.match(r"\s+wildcards: .*solver=([\w-]+), run_id=(\w+)", line)) and current:
+            jobs[current]["solver"], jobs[current]["run_id"] = match.groups()
         elif match := re.match(r"Finished jobid: (\d+)", line):
             jobs[match.group(1)]["end"] = stamp
     return {key: job for key, job in jobs.items() if "end" in job}
-
-
-def thermal_runs(study):
-    """Run ids of the study's runs at a finite temperature (from their provenance records)."""
-    found = set()
-    for record in Path(study).glob("sim/*/*.provenance.json"):
-        params = json.loads(record.read_text()).get("params", {})
-        if float(params.get("temperature") or 0.0) > 0.0:
-            found.add(record.name.split(".")[0])
-    return found
 
 
 def replay(jobs, cores, priority, rank):
@@ -86,26 +77,34 @@ def replay(jobs, cores, priority, rank):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("log", help="the log of a Snakemake run (its standard output and error)")
-    parser.add_argument("--study", help="the study's results tree (default: results/<name> read from the log)")
+    parser.add_argument("--configfile", required=True, help="the study's config (the one the log's run had)")
     parser.add_argument("--cores", type=int, default=2)
     parser.add_argument("--orders", type=int, default=40, help="random orders of the jobs of equal priority")
     args = parser.parse_args(argv)
     jobs = read_jobs(args.log)
     if not jobs:
         parser.error(f"log: no finished Snakemake job in {args.log}")
-    study = args.study or re.search(r"(results/[^/\s]+)/", Path(args.log).read_text()).group(1)
+    study = Study(yaml.safe_load(Path(args.configfile).read_text()), [args.configfile])
     start = min(job["start"] for job in jobs.values())
     for job in jobs.values():
         job["duration"] = (job["end"] - job["start"]).total_seconds()
-    thermal = thermal_runs(study)
-    policies = {
-        "no priorities": lambda key: 0,
-        "the workflow's": lambda key: (ANALYSIS_PRIORITY if jobs[key]["rule"] == "events" else
-                                       int(jobs[key]["rule"] == "simulate" and jobs[key]["run_id"] in thermal)),
-    }
+    unknown = sorted({f"{job['solver']}/{job['run_id']}" for job in jobs.values() if job["rule"] == "simulate"}
+                     - {f"{sim.solver}/{sim.run_id}" for sim in study.simulations})
+    if unknown:
+        parser.error(f"--configfile: runs {', '.join(unknown)} of the log are not in the study of {args.configfile} "
+                     "(give the config the logged run had)")
+
+    def workflow_priority(key):
+        job = jobs[key]
+        if job["rule"] == "events":
+            return ANALYSIS_PRIORITY
+        return study.run_priority(job["solver"], job["run_id"]) if job["rule"] == "simulate" else 0
+
+    policies = {"no priorities": lambda key: 0, "the workflow's": workflow_priority}
     total = sum(job["duration"] for job in jobs.values())
     measured = (max(job["end"] for job in jobs.values()) - start).total_seconds()
-    print(f"{len(jobs)} jobs, {len(thermal)} runs at a finite temperature; measured {measured / 60:.1f} min; jobs' "
+    first = sum(workflow_priority(key) > 0 for key in jobs if jobs[key]["rule"] == "simulate")
+    print(f"{len(jobs)} jobs, {first} runs first; measured {measured / 60:.1f} min; jobs' "
           f"time {total / 60:.1f} min, over {args.cores} cores {total / args.cores / 60:.1f} min")
     logged = {key: k for k, key in enumerate(sorted(jobs, key=lambda key: jobs[key]["start"]))}
     generator = random.Random(1)

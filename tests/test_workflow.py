@@ -351,6 +351,7 @@ def test_thermal_runs_and_then_analyses_come_first_in_the_schedule():
     from stickslip.study_plan import ANALYSIS_PRIORITY
 
     study = Study({"solvers": {"fem": [{"params": {"N": 9, "plates": 2}, "grid": {"temperature": [0.0, 1e-3]}}]}})
-    priorities = {sim.params.get("temperature", 0.0): study.run_priority(sim.solver, sim.run_id) for sim in study.simulations}
+    priorities = {sim.params.get("temperature", 0.0): study.run_priority(sim.solver, sim.run_id)
+                  for sim in study.simulations}
     assert priorities == {0.0: 0, 1e-3: 1}
     assert ANALYSIS_PRIORITY > max(priorities.values())
