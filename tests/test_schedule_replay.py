@@ -8,42 +8,28 @@ SPEC = importlib.util.spec_from_file_location("schedule_replay", REPO / "benchma
 schedule_replay = importlib.util.module_from_spec(SPEC)
 SPEC.loader.exec_module(schedule_replay)
 
-LOG = """\
-[Sun Nov 29 11:00:00 2026]
-localrule simulate:
-    jobid: 1
-    wildcards: solver=fem, run_id=aaaa
-[Sun Nov 29 11:00:00 2026]
-localrule simulate:
-    jobid: 2
-    wildcards: solver=fem, run_id=bbbb
-[Sun Nov 29 11:01:00 2026]
-Finished jobid: 1 (Rule: simulate)
-[Sun Nov 29 11:01:00 2026]
-Finished jobid: 2 (Rule: simulate)
-[Sun Nov 29 11:01:00 2026]
-localrule simulate:
-    jobid: 3
-    wildcards: solver=fem, run_id=tttt
-[Sun Nov 29 11:02:00 2026]
-Finished jobid: 3 (Rule: simulate)
-[Sun Nov 29 11:02:00 2026]
-localrule events:
-    jobid: 4
-    wildcards: analysis=thermal-events, solver=fem, run_id=tttt
-[Sun Nov 29 11:03:40 2026]
-Finished jobid: 4 (Rule: events)
-[Sun Nov 29 11:03:40 2026]
-localrule database:
-    jobid: 5
-[Sun Nov 29 11:03:41 2026]
-Finished jobid: 5 (Rule: database)
-"""
+#: (jobid, rule, wildcards, start, end [s after 11:00]): two athermal runs, a thermal run and its analysis, the database
+JOBS = [("1", "simulate", "solver=fem, run_id=aaaa", 0, 60), ("2", "simulate", "solver=fem, run_id=bbbb", 0, 60),
+        ("3", "simulate", "solver=fem, run_id=tttt", 60, 120),
+        ("4", "events", "analysis=thermal-events, solver=fem, run_id=tttt", 120, 220), ("5", "database", "", 220, 221)]
+
+
+def snakemake_log(jobs):
+    """A Snakemake log of ``jobs``: a stamped block where each starts, a stamped line where each ends (ends first)."""
+    def stamp(seconds):
+        return f"[Sun Nov 29 11:{seconds // 60:02d}:{seconds % 60:02d} 2026]"
+
+    lines = []
+    for jobid, rule, wildcards, start, end in jobs:
+        block = f"localrule {rule}:\n    jobid: {jobid}\n" + (f"    wildcards: {wildcards}\n" if wildcards else "")
+        lines += [(start, 1, f"{stamp(start)}\n{block}"),
+                  (end, 0, f"{stamp(end)}\nFinished jobid: {jobid} (Rule: {rule})\n")]
+    return "".join(text for *_, text in sorted(lines))
 
 
 def test_the_replay_reads_the_log_and_puts_the_long_chain_first(tmp_path):
     log = tmp_path / "snakemake.log"
-    log.write_text(LOG)
+    log.write_text(snakemake_log(JOBS))
     jobs = schedule_replay.read_jobs(log)
     assert [(job["rule"], job["run_id"]) for job in jobs.values()] == [
         ("simulate", "aaaa"), ("simulate", "bbbb"), ("simulate", "tttt"), ("events", "tttt"), ("database", None)]
