@@ -145,8 +145,7 @@ def true_summary(study):
             for below, part in peaks.groupby("below") if "below" in peaks else [(0.02, peaks)]:
                 held = part.drop_duplicates(["run", "state", "hold_time"])
                 for a, mine in part.groupby("interface"):
-                    # a state's slope from at least three of its holds, from both where a study holds twice
-                    age = paired_slopes(mine, t_min=0.0, time="age", min_points=min(3, mine["hold_time"].nunique()))
+                    age = paired_slopes(mine, t_min=0.0, time="age")
                     hold = paired_slopes(mine)
                     bend = curvature(mine.assign(hold_time=mine["age"]), t_min=0.0) if len(mine) > 5 else (
                         math.nan, math.nan)

@@ -71,6 +71,8 @@ def test_paired_slopes_are_the_mean_of_the_states_slopes_without_failed_holds():
     failed.loc[(failed["state"] == 0) & (failed["hold_time"] >= 1e10), "failed_in_hold"] = True
     failed.loc[(failed["state"] == 0) & (failed["hold_time"] >= 1e10), "peak"] = 9.0  # the held stress: left out
     assert paired_slopes(failed)[2] == 2  # state 0 keeps 2 points < 3
+    twice = peaks[peaks["hold_time"].isin([1e6, 1e12])]  # a study that holds every state twice: a slope from both
+    assert paired_slopes(twice)[0] == pytest.approx(0.005, rel=1e-9) and paired_slopes(twice)[2] == 3
     line = _holds([0.005] * 4, noise=1e-4)
     bend, bend_error = curvature(line)
     assert abs(bend) < 3 * bend_error

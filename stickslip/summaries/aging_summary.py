@@ -122,6 +122,8 @@ def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3, time="hold_time
     t_min : float
         Smallest hold time fitted [time] (shorter holds are shorter than the reload to the peak).
     min_points : int
+        Holds a state's slope needs at least (all the hold times of ``peaks`` where there are fewer: a study that
+        holds each state twice gets a slope from both).
     time : str
         The time of the logarithm: ``hold_time`` (T_w), or a column of the contacts' age at the peak
         (:func:`stickslip.summaries.dissonance_summary.peak_ages`).
@@ -133,12 +135,13 @@ def paired_slopes(peaks, column="peak", t_min=1e6, min_points=3, time="hold_time
     """
     chosen = peaks[(peaks["hold_time"] >= t_min) & ~peaks["failed_in_hold"].astype(bool)]
     keys = [key for key in ("run", "state", "below", "interface") if key in chosen]
+    needed = min(min_points, chosen["hold_time"].nunique())
     slopes = []
     for _, group in chosen.groupby(keys):
         values = group[column].to_numpy(dtype=float)
         x = np.log(group[time].to_numpy(dtype=float))
         ok = np.isfinite(values)
-        if ok.sum() >= min_points and np.ptp(x[ok]) > 0:
+        if ok.sum() >= needed and np.ptp(x[ok]) > 0:
             slopes.append(np.polyfit(x[ok], values[ok], 1)[0])
     return mean_sem(slopes)
 
