@@ -9,7 +9,8 @@ Files that a long run appends to (:mod:`stickslip.fem.run`) are written in
 HDF5's single-writer/multiple-reader (SWMR) mode, so that a killed writer leaves a
 readable file: :func:`open_file` reads such a file (running, or left "open for
 write" by a killed process) through SWMR, :func:`copy_file` rewrites it into a
-fresh file whose bytes depend only on its contents, and
+fresh file whose bytes depend only on its contents (keeping the committed rows of a
+chunk whose in-place rewrite the kill tore, :mod:`stickslip.output_safety.torn_chunk`), and
 :func:`stickslip.output_safety.lock.writer_lock` keeps a second process from writing the same file.
 
 Tables (event lists, per-increment observables) are stored as a group with one
@@ -40,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from .output_safety.errors import OutputError
+from .output_safety.torn_chunk import committed_rows
 from .output_safety.write_guard import WriteGuard
 
 __all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs", "copy_file",
@@ -389,7 +391,7 @@ def _read(dataset, selection):
         try:
             return dataset[selection]
         except OSError as error:
-            failure = error
+            failure = str(error)  # not the exception: its traceback would keep the caller's datasets open
             if attempt < attempts:  # a running writer may be rewriting the chunk: read it again
                 time.sleep(0.1)
                 dataset.refresh()
@@ -530,7 +532,8 @@ def read_table(group, name, rows=None):
     name : str
     rows : int, optional
         Read only the first ``rows`` rows (of a table being appended to, whose
-        columns may have different lengths while a row is written).
+        columns may have different lengths while a row is written): the committed
+        rows, kept also from a chunk whose rewrite a killed writer tore (:func:`copy_file`).
 
     Returns
     -------
@@ -564,7 +567,8 @@ def read_table(group, name, rows=None):
                               f"{' (the rows the file says it stores)' if rows is not None else ''}")
     data = {}
     for column in columns:
-        values = read_array(sub[column], slice(None, rows))
+        growing = rows is not None and sub[column].maxshape[0] is None
+        values = _read_committed(sub[column], 0, rows, rows) if growing else read_array(sub[column], slice(None, rows))
         if values.dtype.kind in "OS":
             values = np.asarray([v.decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values],
                                 dtype=object)
@@ -584,7 +588,11 @@ def copy_file(source, target, rows):
     source, target : h5py.File
         Open for reading; open for writing (empty, made by :func:`open_file`).
     rows : int
-        Growable datasets (unlimited first dimension) keep their first ``rows`` rows.
+        Growable datasets (unlimited first dimension) keep their first ``rows`` rows: the rows its
+        writer had committed. A chunk of theirs that a writer killed while appending row ``rows``
+        tore is copied from its committed rows where its old checksum proves them
+        (:func:`stickslip.output_safety.torn_chunk.committed_rows`); any other damage raises
+        :class:`CorruptFileError`.
     """
     def copy_attrs(src, dst):
         for name in sorted(src.attrs):
@@ -607,9 +615,35 @@ def copy_file(source, target, rows):
             elif shape[0]:
                 row_bytes = obj.dtype.itemsize * int(np.prod(shape[1:]))
                 for start, stop in _blocks(shape[0], row_bytes, obj.chunks[0] if obj.chunks else 1):
-                    out[start:stop] = read_array(obj, slice(start, stop))
+                    out[start:stop] = _read_committed(obj, start, stop, rows) if growable else \
+                        read_array(obj, slice(start, stop))
             copy_attrs(obj, out)
 
     copy_group(source, target)
 
 
+def _read_committed(dataset, start, stop, committed):
+    """Rows ``start ... stop - 1`` (``stop <= committed``) of a growable dataset, through a chunk torn by a kill.
+
+    Raises
+    ------
+    CorruptFileError
+        If a chunk cannot be read and is not a torn chunk whose committed rows its old checksum proves
+        (:func:`stickslip.output_safety.torn_chunk.committed_rows`).
+    """
+    try:
+        return read_array(dataset, slice(start, stop))
+    except CorruptFileError as error:
+        damage = str(error)  # not the exception: its traceback would keep the caller's datasets open
+    size = dataset.chunks[0]
+    parts = []
+    for first in range(start - start % size, stop, size):
+        low, high = max(first, start), min(first + size, stop)
+        try:
+            parts.append(read_array(dataset, slice(low, high)))
+        except CorruptFileError:
+            rows = committed_rows(dataset, first, committed)
+            if rows is None or rows.shape[0] < high - first:
+                raise CorruptFileError(damage) from None
+            parts.append(rows[low - first:high - first])
+    return np.concatenate(parts)

@@ -4,6 +4,7 @@ The format stores the producer's parameters as opaque JSON and the header fields
 need as typed attributes; the analyses read it without loading any module of ``stickslip.fem``.
 """
 
+import io
 import subprocess
 import sys
 
@@ -13,7 +14,7 @@ import pytest
 
 from stickslip import formats
 from stickslip.formats import fem_run
-from stickslip.h5io import FileFormatError, open_file
+from stickslip.h5io import FileFormatError, open_file, read_array
 from stickslip.mesh import MeshParams, build_stack_mesh
 
 #: A producer that is not the ``fem`` solver: parameters the format never interprets.
@@ -145,3 +146,59 @@ def test_the_analyses_load_no_module_of_the_solver():
     loaded, analyses = done.stdout.split("\n")[:2]
     assert loaded == "[]"
     assert int(analyses) >= 13  # the probe did import the analyses
+
+
+def _append_running(path, increments):
+    """Append ``increments`` more increments to the running (SWMR) file ``path``, as the fem loop does."""
+    ndof, nlayer = 0, 0
+    with open_file(path, "r+") as file:
+        file.swmr_mode = True
+        ndof, nlayer = file["state/u"].shape[1], file["state/target"].shape[1]
+        for i in range(file["state/t"].shape[0], file["state/t"].shape[0] + increments):
+            state = (np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i + 0.05)
+            fem_run.append_increment(file, state, {"increment": i, "kick": i % 2 == 0, "yield_element": False,
+                                                   "t": 0.1 * i + 0.05, "sigd": 1.5 * i, "S_a1": i, "A_a1": 9 * i})
+            if i == 4:
+                before = path.read_bytes()  # the file killed after committing 5 increments
+    return before, path.read_bytes()
+
+
+def test_a_chunk_torn_by_a_kill_keeps_its_committed_rows_and_other_damage_is_refused(tmp_path):
+    """A kill inside the in-place rewrite of a chunk leaves its new bytes up to a page boundary and its
+    old bytes (old checksum included) after it; the resume keeps the 5 committed rows of every such tear,
+    so the rewritten file is the one of a kill between increments, byte for byte."""
+    path = tmp_path / "run.h5"
+    _write(path, increments=2)
+    before, after = _append_running(path, 4)  # the sixth increment was being written when the kill came
+    expected = tmp_path / "expected.h5"
+    expected.write_bytes(before)
+    fem_run.rewrite(expected)
+    with h5py.File(expected) as file:
+        growable = ["state/t", "state/target", "state/lever_target", "increments/sigd", "increments/S_a1"]
+        assert all(file[name].shape[0] == 5 for name in growable)
+    torn = tmp_path / "torn.h5"
+    tears = 0
+    for name in growable:
+        with h5py.File(io.BytesIO(after), "r") as file:
+            chunk = file[name].id.get_chunk_info_by_coord((0,) * file[name].ndim)
+        start, stop = chunk.byte_offset, chunk.byte_offset + chunk.size
+        assert before[start:stop] != after[start:stop]  # rewritten in place
+        for page in range(start // 4096 + 1, (stop - 1) // 4096 + 1):
+            cut = page * 4096
+            torn.write_bytes(before[:start] + after[start:cut] + before[cut:])
+            with open_file(torn) as file, pytest.raises(FileFormatError, match=f"{name} is damaged"):
+                read_array(file[name])
+            assert fem_run.read_increments(torn).equals(fem_run.read_increments(expected))  # a reader of the killed file
+            fem_run.rewrite(torn)
+            assert torn.read_bytes() == expected.read_bytes(), (name, cut)
+            tears += 1
+    assert tears >= 8  # a chunk of 1024 numbers (8 KiB) spans one or two page boundaries
+    # a committed row changed, not a tear: refused, and the file is left as it was
+    with h5py.File(io.BytesIO(after), "r") as file:
+        offset = file["increments/sigd"].id.get_chunk_info_by_coord((0,)).byte_offset
+    damaged = bytearray(before)
+    damaged[offset + 8 * 2] ^= 1
+    torn.write_bytes(bytes(damaged))
+    with pytest.raises(FileFormatError, match="increments/sigd is damaged"):
+        fem_run.rewrite(torn)
+    assert torn.read_bytes() == bytes(damaged)

@@ -8,6 +8,8 @@ itself exports nothing):
   computation if the output cannot be written);
 - :mod:`.space`: :func:`~.space.check_free_space` for a writer that appends in place;
 - :mod:`.lock`: :func:`~.lock.writer_lock`, one writer per file;
+- :mod:`.torn_chunk`: :func:`~.torn_chunk.committed_rows`, the rows of a chunk whose in-place
+  rewrite a killed appender tore, kept where the chunk's old checksum proves them;
 - :mod:`.write_guard`: the file object through which HDF5 writes a new file, so that a full disk is
   an error (:class:`~.errors.OutputError`), never a crash;
 - :mod:`.errors`: :class:`~.errors.OutputError`.
