@@ -32,10 +32,15 @@ def _write(path, header=HEADER, increments=3):
     with open_file(path, "w") as file:
         fem_run.create_file(file, header, mesh, response, ["t", "sigd", "S_a1", "A_a1"])
         for i in range(increments):
-            state = (np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i)
-            fem_run.append_increment(file, state, {"increment": i, "kick": i % 2 == 0, "yield_element": False,
-                                                   "t": 0.1 * i, "sigd": 1.5 * i, "S_a1": i, "A_a1": 9 * i})
+            fem_run.append_increment(file, *_increment(i, ndof, nlayer))
     return mesh, response
+
+
+def _increment(i, ndof, nlayer):
+    """The state and the row of increment ``i`` of the files written here."""
+    state = (np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i)
+    return state, {"increment": i, "kick": i % 2 == 0, "yield_element": False, "t": 0.1 * i, "sigd": 1.5 * i,
+                   "S_a1": i, "A_a1": 9 * i}
 
 
 def test_a_producer_with_other_parameters_writes_a_readable_file(tmp_path):
@@ -148,19 +153,17 @@ def test_the_analyses_load_no_module_of_the_solver():
     assert int(analyses) >= 13  # the probe did import the analyses
 
 
-def _append_running(path, increments):
-    """Append ``increments`` more increments to the running (SWMR) file ``path``, as the fem loop does."""
-    ndof, nlayer = 0, 0
+def _append_running(path, increments, killed_at):
+    """Append ``increments`` increments to ``path`` as the fem loop does (SWMR); the bytes once ``killed_at``
+    increments are stored (a kill between increments) and at the end (a kill inside the next append)."""
     with open_file(path, "r+") as file:
         file.swmr_mode = True
         ndof, nlayer = file["state/u"].shape[1], file["state/target"].shape[1]
         for i in range(file["state/t"].shape[0], file["state/t"].shape[0] + increments):
-            state = (np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i + 0.05)
-            fem_run.append_increment(file, state, {"increment": i, "kick": i % 2 == 0, "yield_element": False,
-                                                   "t": 0.1 * i + 0.05, "sigd": 1.5 * i, "S_a1": i, "A_a1": 9 * i})
-            if i == 4:
-                before = path.read_bytes()  # the file killed after committing 5 increments
-    return before, path.read_bytes()
+            fem_run.append_increment(file, *_increment(i, ndof, nlayer))
+            if i + 1 == killed_at:
+                between = path.read_bytes()
+    return between, path.read_bytes()
 
 
 def test_a_chunk_torn_by_a_kill_keeps_its_committed_rows_and_other_damage_is_refused(tmp_path):
@@ -169,7 +172,7 @@ def test_a_chunk_torn_by_a_kill_keeps_its_committed_rows_and_other_damage_is_ref
     so the rewritten file is the one of a kill between increments, byte for byte."""
     path = tmp_path / "run.h5"
     _write(path, increments=2)
-    before, after = _append_running(path, 4)  # the sixth increment was being written when the kill came
+    before, after = _append_running(path, 4, killed_at=5)  # the sixth increment was being written at the kill
     expected = tmp_path / "expected.h5"
     expected.write_bytes(before)
     fem_run.rewrite(expected)
