@@ -14,7 +14,7 @@ import numpy as np
 
 from .event_driven import autoscale
 from .laws import Elastic
-from .yield_strains import interface_initstate, narrowest_well
+from .yield_strains import element_scale, interface_initstate, narrowest_well
 
 __all__ = ["LinearResponse", "compute_linear_response"]
 
@@ -52,6 +52,7 @@ def compute_linear_response(stack, model, relaxation, params, mesh):
     relaxation.equilibrate_linear(backend)
     u, eps = backend.read("u", "eps")
     scale = autoscale(narrowest_well(interface_initstate(params.seed, mesh.N, mesh.n_interfaces), params.nchunk,
-                                     params.eps0, params.eps_offset, params.weibull_k), eps)
+                                     params.eps0, params.eps_offset, params.weibull_k,
+                                     element_scale(params.interface_strength, mesh.N, mesh.n_interfaces)), eps)
     lever = scale * params.eps0 if model.free_lever else 0.0
     return LinearResponse(scale * u, scale * eps, scale * unit_target, float(lever))

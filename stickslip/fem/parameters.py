@@ -163,10 +163,19 @@ class FemParams:
     junction_attempt_rate: float = param(1.0, "junction aging: a junction of depth E is redrawn at rest at the rate "
                                               "nu_j exp(-E / temperature)", unit="1/time", exclusive_minimum=0.0,
                                          extension="junction_strengthening")
+    interface_strength: tuple[float, ...] = param((), "scale of the yield strains (every well's width and offset) of "
+                                                      "each interface, bottom to top: one value for all or one per "
+                                                      "interface; empty: 1 (the paper's). An interface of scale s "
+                                                      "peaks and drops s times higher, its barriers s^2 times "
+                                                      "(docs/fem.md, 'Interfaces of different strength')",
+                                                  exclusive_minimum=0.0, extension=True)
 
     def check(self):
         """Check conditions across fields."""
         self._check_law()
+        if len(self.interface_strength) not in (0, 1, self.plates - 1):
+            raise ParameterError(f"parameter 'interface_strength': expected one value or one per interface (plates - 1 "
+                                 f"= {self.plates - 1}), got {len(self.interface_strength)}")
         if self.temperature > 0.0 and self.yield_strains != "extend":
             raise ParameterError("parameter 'yield_strains': a thermal run (temperature > 0) needs 'extend'")
         if self.hold_delay != 0.0 and not self.hold_times:

@@ -18,7 +18,7 @@ from .errors import SolverError
 from .laws import make_law
 from .model import build_model
 from .window import HeldWindow
-from .yield_strains import HeldYieldStrains, interface_initstate
+from .yield_strains import HeldYieldStrains, element_scale, interface_initstate
 
 __all__ = ["Stack", "stack_model"]
 
@@ -193,10 +193,11 @@ def stack_model(params, mesh, constants):
         If a held well is narrower than the kick ``deps``.
     """
     extend = params.yield_strains == "extend"
+    scale = element_scale(params.interface_strength, mesh.N, mesh.n_interfaces)
     wells = HeldYieldStrains(interface_initstate(params.seed, mesh.N, mesh.n_interfaces),
                              params.window if extend else params.nchunk, params.eps0, params.eps_offset,
-                             params.weibull_k)
-    narrowest = min(np.min(np.diff(wells.epsy, axis=1)), params.eps_offset if extend else np.inf)
+                             params.weibull_k, scale)
+    narrowest = min(np.min(np.diff(wells.epsy, axis=1)), params.eps_offset * scale.min() if extend else np.inf)
     if narrowest <= constants["deps"]:
         raise SolverError("a well is narrower than the kick 'deps'; use a smaller 'deps' or larger 'eps_offset'")
     plastic = np.asarray(mesh.layer_is_plastic, dtype=bool)

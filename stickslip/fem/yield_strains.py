@@ -5,9 +5,10 @@ Each interface element ``e`` owns one pcg32 generator seeded with
 interface, blocks left to right), ``base = seed * N * (max_plates - 1)`` with
 ``max_plates = 100``: the same seed gives the same disorder on the first
 interfaces whatever the number of plates. Its wells have widths
-``2 eps0 w + eps_offset`` with ``w ~ Weibull(k, 1)``; the yield strains are their
-cumulative sum ``eps_y[j]``, and the sequence is prepended with ``-eps_y[0]`` so
-that the initial well ``[-eps_y[0], eps_y[0]]`` is centred on zero strain.
+``2 eps0 w + eps_offset`` with ``w ~ Weibull(k, 1)``, times the strength scale of its
+interface (1 unless ``interface_strength`` says otherwise: :func:`element_scale`); the
+yield strains are their cumulative sum ``eps_y[j]``, and the sequence is prepended with
+``-eps_y[0]`` so that the initial well ``[-eps_y[0], eps_y[0]]`` is centred on zero strain.
 Reference: shared/reference-model.md, section 4.
 
 The sequence of a block is unbounded: :class:`HeldYieldStrains` holds ``ny``
@@ -24,7 +25,7 @@ import numpy as np
 from ..numba_options import njit
 from .random import pcg32_next, pcg32_seed
 
-__all__ = ["MAX_PLATES", "seed_base", "interface_initstate", "yield_strains", "narrowest_well",
+__all__ = ["MAX_PLATES", "seed_base", "interface_initstate", "element_scale", "yield_strains", "narrowest_well",
            "HeldYieldStrains"]
 
 #: Plates reserved per realisation when spacing the seeds (the paper's ``--max-plates``).
@@ -71,24 +72,46 @@ def interface_initstate(seed, N, n_interfaces):
     return seed_base(seed, N) + np.arange(N * n_interfaces, dtype=np.int64)
 
 
+def element_scale(strengths, N, n_interfaces):
+    """The strength scale of every interface element's wells (``interface_strength`` per element).
+
+    Parameters
+    ----------
+    strengths : Sequence[float]
+        One scale for every interface, or one per interface (bottom to top); empty: 1.
+    N : int
+        Blocks per interface.
+    n_interfaces : int
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 [n_interfaces * N]: element ``(a - 1) * N + b`` has interface ``a``'s scale.
+    """
+    values = np.ones(n_interfaces) if len(strengths) == 0 else np.broadcast_to(
+        np.asarray(strengths, dtype=np.float64), (n_interfaces,))
+    return np.repeat(values, N)
+
+
 @njit
-def _next_yield_strain(state, inc, row, last, two_eps0, eps_offset, inv_k):
-    """The yield strain after ``last`` of block ``row``: ``last + 2 eps0 w + eps_offset``, one draw."""
+def _next_yield_strain(state, inc, row, last, two_eps0, eps_offset, inv_k, scale):
+    """The yield strain after ``last`` of block ``row``: ``last + scale[row] (2 eps0 w + eps_offset)``, one draw
+    (a scale of 1 leaves every bit as without it)."""
     r = float(pcg32_next(state, inc, row)) / _TWO_POW_32
-    return last + (two_eps0 * (-math.log(1.0 - r)) ** inv_k + eps_offset)
+    return last + scale[row] * (two_eps0 * (-math.log(1.0 - r)) ** inv_k + eps_offset)
 
 
 @njit
-def _fill(epsy, start, state, inc, last, two_eps0, eps_offset, inv_k):
+def _fill(epsy, start, state, inc, last, two_eps0, eps_offset, inv_k, scale):
     """Fill ``epsy[e, start[e]:]`` with the next yield strains of every block ``e``; updates ``last``."""
     for e in range(epsy.shape[0]):
         for j in range(start[e], epsy.shape[1]):
-            last[e] = _next_yield_strain(state, inc, e, last[e], two_eps0, eps_offset, inv_k)
+            last[e] = _next_yield_strain(state, inc, e, last[e], two_eps0, eps_offset, inv_k, scale)
             epsy[e, j] = last[e]
 
 
 @njit
-def _slide(epsy, offset, shift, state, inc, last, two_eps0, eps_offset, inv_k):
+def _slide(epsy, offset, shift, state, inc, last, two_eps0, eps_offset, inv_k, scale):
     """Move the window of every block ``e`` forward by ``shift[e]`` values (drawing as many new ones)."""
     ny = epsy.shape[1]
     start = np.full(epsy.shape[0], ny, dtype=np.int64)
@@ -100,19 +123,19 @@ def _slide(epsy, offset, shift, state, inc, last, two_eps0, eps_offset, inv_k):
             epsy[e, j] = epsy[e, j + s]
         offset[e] += s
         start[e] = ny - s
-    _fill(epsy, start, state, inc, last, two_eps0, eps_offset, inv_k)
+    _fill(epsy, start, state, inc, last, two_eps0, eps_offset, inv_k, scale)
 
 
 @njit
-def _narrowest(state, inc, nwell, two_eps0, eps_offset, inv_k):
+def _narrowest(state, inc, nwell, two_eps0, eps_offset, inv_k, scale):
     """Narrowest of the first ``nwell`` wells of every block (differences of the held values)."""
     width = np.inf
     for e in range(state.size):
-        first = _next_yield_strain(state, inc, e, 0.0, two_eps0, eps_offset, inv_k)
+        first = _next_yield_strain(state, inc, e, 0.0, two_eps0, eps_offset, inv_k, scale)
         width = min(width, first - (-first))
         previous = first
         for _ in range(nwell - 1):
-            value = _next_yield_strain(state, inc, e, previous, two_eps0, eps_offset, inv_k)
+            value = _next_yield_strain(state, inc, e, previous, two_eps0, eps_offset, inv_k, scale)
             width = min(width, value - previous)
             previous = value
     return width
@@ -123,7 +146,7 @@ def _generators(initstate):
     return pcg32_seed(initstate, np.zeros_like(initstate))
 
 
-def yield_strains(initstate, nchunk, eps0, eps_offset, k):
+def yield_strains(initstate, nchunk, eps0, eps_offset, k, scale=None):
     """Yield-strain sequence of each element, including the symmetric first well.
 
     Parameters
@@ -138,16 +161,18 @@ def yield_strains(initstate, nchunk, eps0, eps_offset, k):
         Minimal well width [strain].
     k : float
         Weibull shape parameter.
+    scale : numpy.ndarray, optional
+        float64 [nelem]: each element's strength scale (:func:`element_scale`); None: 1.
 
     Returns
     -------
     numpy.ndarray
         float64 [nelem, nchunk + 1]: ``[-eps_y0, eps_y0, eps_y1, ...]``, increasing.
     """
-    return HeldYieldStrains(initstate, nchunk, eps0, eps_offset, k).epsy
+    return HeldYieldStrains(initstate, nchunk, eps0, eps_offset, k, scale).epsy
 
 
-def narrowest_well(initstate, nchunk, eps0, eps_offset, k):
+def narrowest_well(initstate, nchunk, eps0, eps_offset, k, scale=None):
     """Width of the narrowest well among the first ``nchunk + 1`` yield strains of every element [strain].
 
     Equals the smallest difference of consecutive values of :func:`yield_strains`
@@ -159,7 +184,11 @@ def narrowest_well(initstate, nchunk, eps0, eps_offset, k):
     float
     """
     state, inc = _generators(initstate)
-    return float(_narrowest(state, inc, int(nchunk), 2.0 * eps0, eps_offset, 1.0 / k))
+    return float(_narrowest(state, inc, int(nchunk), 2.0 * eps0, eps_offset, 1.0 / k, _scale(scale, state.size)))
+
+
+def _scale(scale, nelem):
+    return np.ones(nelem) if scale is None else np.ascontiguousarray(scale, dtype=np.float64)
 
 
 class HeldYieldStrains:
@@ -176,6 +205,8 @@ class HeldYieldStrains:
         Wells held at the start per element (``ny = nwell + 1`` values).
     eps0, eps_offset, k : float
         See :func:`yield_strains`.
+    scale : numpy.ndarray, optional
+        float64 [nelem]: each element's strength scale (:func:`element_scale`); None: 1.
 
     Attributes
     ----------
@@ -185,9 +216,9 @@ class HeldYieldStrains:
         int64 [nelem]: global index of ``epsy[:, 0]``.
     """
 
-    def __init__(self, initstate, nwell, eps0, eps_offset, k):
+    def __init__(self, initstate, nwell, eps0, eps_offset, k, scale=None):
         self.initstate = np.asarray(initstate, dtype=np.int64)
-        self._constants = (2.0 * eps0, float(eps_offset), 1.0 / k)
+        self._constants = (2.0 * eps0, float(eps_offset), 1.0 / k, _scale(scale, self.initstate.size))
         self.start(int(nwell))
 
     def start(self, nwell):

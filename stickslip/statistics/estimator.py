@@ -33,7 +33,12 @@ from scipy import stats
 
 from ..experiment.aging import FITS, fit_aging
 
-__all__ = ["ESTIMATE_COLUMNS", "estimate", "estimator_table", "synthetic_slips", "biases"]
+__all__ = ["ESTIMATE_COLUMNS", "LAB_LOADING_RATE", "estimate", "estimator_table", "synthetic_slips", "lab_rate",
+           "lab_slips", "biases"]
+
+#: The lab's loading rate of an interface driven alone, ``K h gamma_dot / N`` [1/s]: K = 55 N/mm, h = 10 mm,
+#: gamma_dot = 1e-4 /s, N = 49 N (the ``lever`` solver's defaults); a drop of 0.2 takes ~180 s to load.
+LAB_LOADING_RATE = 55.0 * 10.0 * 1e-4 / 49.0
 
 #: Columns of :func:`estimate` (and of every row of :func:`estimator_table` after its group keys).
 ESTIMATE_COLUMNS = ["fit", "B", "B_error", "B_low", "B_high", "c", "c_error", "c_low", "c_high", "slips", "bins",
@@ -153,6 +158,63 @@ def synthetic_slips(rng, count, *, B, gap, drop, disorder, path_spread, T_typica
     T = T_typical * path * np.maximum(dmu, 1e-12 * drop) / drop
     return pd.DataFrame({"T": T, "dmu": dmu, "multi": np.zeros(count, dtype=bool), "path": path,
                          "threshold": threshold})
+
+
+def lab_rate(a, n):
+    """The lab's loading rate of interface ``a`` of a stack of ``n`` relative to ``a`` driven alone,
+    ``(n + a)(n - a + 1) / 2`` (the paper's section "Complex loading path")."""
+    return (n + a) * (n - a + 1) / 2.0
+
+
+def lab_slips(rng, count, *, B, strengths, disorder, path_spread, stacks=(1, 2, 3, 4, 5), direct=0.0, t0=1.0,
+              loading_rate=LAB_LOADING_RATE):
+    """Slips of known aging rate pooled as the paper's Fig. 5c pools them: every interface ``a`` of every stack ``n``.
+
+    Interface ``a`` has its own strength (its typical drop driven alone, ``strengths[a - 1]``: the paper's 0.15-0.3;
+    the strength offset ``gap`` of :func:`synthetic_slips` is the interface's) and is loaded at ``loading_rate lab_rate(a, n)``; its slips are :func:`synthetic_slips` with the disorder
+    law at that rate (``T = P dmu / rate``), the aging rate ``B``, and the loading path's factor ``P`` log-normal with
+    ``std(ln P) = path_spread`` in stacks (1 alone: nothing interrupts an interface driven alone). ``direct`` adds a
+    dependence of the peak on the loading rate, ``direct ln(lab_rate)`` (rate-and-state's ``a ln V``), which the
+    aging does not make.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    count : int
+        Slips per (interface, stack).
+    B : float
+        The true aging rate [per e-fold of T].
+    strengths : Sequence[float]
+        The mean drop of each interface driven alone (interfaces 1, 2, ... from the bottom).
+    disorder : float
+        Relative spread of the thresholds.
+    path_spread : float
+        ``std(ln P)`` in stacks of ``n > 1``.
+    stacks : Sequence[int]
+        The values of ``n``; interface ``a`` slips in every stack with ``n >= a``.
+    direct : float
+        The peak's rise per e-fold of the loading rate.
+    t0 : float
+        [s]
+    loading_rate : float
+        [1/s]
+
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`synthetic_slips`' columns with ``interface`` and ``n``.
+    """
+    parts = []
+    for n in stacks:
+        for a in range(1, n + 1):
+            drop = float(strengths[a - 1])
+            rate = lab_rate(a, n)
+            typical = drop / (loading_rate * rate)
+            gap = drop - B * math.log(drop / (loading_rate * t0)) + direct * math.log(rate)  # drop alone: strength
+            part = synthetic_slips(rng, count, B=B, gap=gap, drop=drop, disorder=disorder,
+                                   path_spread=path_spread if n > 1 else 0.0, T_typical=typical, t0=t0)
+            parts.append(part.assign(interface=a, n=n))
+    return pd.concat(parts, ignore_index=True)
 
 
 def biases(*, gap, drop, disorder, std_lnT, mean_ln):

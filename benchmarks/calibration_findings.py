@@ -1,0 +1,504 @@
+"""The paper's aging estimator calibrated against the truth: the numbers of docs/numerical-analysis.md, "Slip
+dissonance" (issue 56).
+
+    python benchmarks/calibration_findings.py results/calibration results/calibration-b \\
+        results/calibration-stacks results/pooling results/drive-precheck
+
+Reads the studies of workflow/config/calibration.yaml, calibration-b.yaml (the thermal n = 1 runs at Phi = 5e-9, 4
+lambda, seeds 1-5), calibration-stacks.yaml (n = 2, lambda 0 and 5, seeds 1-3), pooling.yaml (interfaces of
+different strength, fem and rate-and-state twin) and drive-precheck.yaml (the athermal pre-check of the decisive
+drive); a study that is missing leaves its sections empty. Prints, each number with the seeds, states or slips
+behind it (errors over seeds: the standard error of the seeds' spread, ``sd / sqrt(k)``; within-seed errors beside
+them: the root mean square of the seeds' own errors over ``sqrt(k)``):
+
+1. per lambda and seed: the true B (paired holds against the contacts' age at the peak, and against T_w), the
+   waiting times (re-slips after < 1e6 / nu, std ln T with its normal-theory and bootstrap errors, the robust
+   spread IQR / 1.349), raw and as the lab resolves them; over seeds;
+2. the lab's clock: the model time of one lab second per lambda (resolved slips at <ln(T / T0)> = 4.6);
+3. the paper's estimator (both fits) on the n = 1 slips, on both clocks (T0 = 1 / nu, the lab's), raw and with the
+   lab's resolution: per seed, over seeds, against the truth (ratio and whether it is within 25 %), and the
+   calibration line over lambda and seeds; the same with the n = 2 stacks pooled in (lambda 0 and 5);
+4. the post-slip stress against ln T of the slips after a reload (the paper assumes it constant); the aging-off
+   control's bend;
+5. the true B per interface in the n = 2 stacks;
+6. pooling: the pooled and per-interface fits of interfaces of different strength (fem, twin, synthetic slips with
+   the paper's strengths and loading rates), beside the paper's 0.053 +- 0.005;
+7. the estimator beside the paper's (:mod:`stickslip.statistics.loading_contrast`) against the truth: fem and twin;
+8. the pre-check of the decisive drive: std ln T_a per interface, its robust spread, the share of the loading that
+   other slips take, against the criteria, per N, Phi and n; the go/no-go;
+9. the cost: CPU seconds of every simulation and the wall time of the events jobs, per study.
+"""
+
+import argparse
+import glob
+import json
+import math
+import re
+import warnings
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+
+from stickslip.experiment.timeseries import read_truth
+from stickslip.figures.experimental_data import load_slips
+from stickslip.statistics.calibration import (LAB_MEAN_LN, LAB_RESOLUTION, calibration_line, lab_clock, log_spread,
+                                              merge_unresolved, over_seeds)
+from stickslip.statistics.estimator import estimate, lab_slips
+from stickslip.statistics.loading_contrast import loading_contrast
+from stickslip.summaries.aging_summary import curvature, first_peaks, ratio
+from stickslip.summaries.calibration_summary import load_calibration_runs, post_slip_slope, run_slips, run_truth
+from stickslip.summaries.dissonance_summary import loading_rates, peak_ages
+
+#: The broad drive of the calibration (Phi = 5e-9) and the split of its waiting times: thermal re-slips below
+#: RESLIP, slips after a reload above RELOAD [1 / nu].
+PHI = 5e-9
+RESLIP, RELOAD = 1e6, 1e7
+#: The paper's estimate (its Fig. 5c).
+PAPER_B, PAPER_B_ERROR = 0.053, 0.005
+#: The pre-check's criteria: n = 1 narrow, n >= 3 broad by the lever.
+NARROW, BROAD, INTERRUPTED = 0.4, 0.8, 0.3
+FITS = ("origin", "intercept")
+EYES = ("raw", "lab")
+
+
+def fmt(value, error, digits=4):
+    return f"{value:.{digits}f} ± {error:.{digits}f}"
+
+
+def seeds_line(stats_, digits=4):
+    """'mean ± between [low, high] (within; k seeds)'."""
+    return (f"{fmt(stats_['mean'], stats_['error'], digits)} [{stats_['low']:.{digits}f}, {stats_['high']:.{digits}f}]"
+            f" (within {stats_['within']:.{digits}f}; {stats_['seeds']} seeds)")
+
+
+def calibration_runs(runs):
+    """The calibration's thermal runs at the broad drive with every interface of strength 1."""
+    plain = runs["strength"].apply(lambda s: all(v == 1.0 for v in s))
+    return runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05) & plain & (runs["N"] == 162)]
+
+
+def truth_table(runs):
+    """Per run with holds: its true B per interface, with ``seed``, ``n``, ``strengthening``, ``strength``."""
+    parts = []
+    for _, run in runs.iterrows():
+        if run["holds"] is None:
+            continue
+        table = run_truth(run["holds"])
+        parts.append(table.assign(run=run["run"], seed=run["seed"], n=run["n"], strengthening=run["strengthening"],
+                                  strength=[run["strength"][a - 1] for a in table["interface"]]))
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(
+        columns=["interface", "B", "B_error", "states", "B_hold", "B_hold_error", "failed", "run", "seed", "n",
+                 "strengthening", "strength"])
+
+
+def eye(slips, t0_lab, which):
+    """The slips raw or as the lab resolves them (merged within LAB_RESOLUTION lab seconds)."""
+    return slips if which == "raw" else merge_unresolved(slips, LAB_RESOLUTION * t0_lab)
+
+
+# --- 1. the truth and the waiting times ------------------------------------------------------------------------------
+
+def truth_summary(runs, truth):
+    print("## 1. The calibration runs (n = 1, Phi = 5e-9, T = 1e-3, drive 2e-8, 1000 increments): the true B and "
+          "the waiting times, per lambda and seed")
+    slips = run_slips(runs[runs["n"] == 1])
+    clocks = {}
+    for lam, group in slips.groupby("strengthening"):
+        t0_lab = lab_clock(group)
+        clocks[lam] = (t0_lab, lab_clock(group, merge=False))
+        for seed, mine in group.groupby("seed"):
+            row = truth[(truth["strengthening"] == lam) & (truth["seed"] == seed) & (truth["n"] == 1)]
+            line = f"- lambda {lam:g}, seed {seed}: "
+            if len(row):
+                r = row.iloc[0]
+                bend = _control_bend(runs, lam, seed)
+                line += (f"true B(age) {fmt(r.B, r.B_error)} ({r.states} states), B(T_w) "
+                         f"{fmt(r.B_hold, r.B_hold_error)}, holds failing {r.failed:.2f}, curvature in ln age "
+                         f"{fmt(*bend, 5)}; ")
+            T = mine["T"].to_numpy(dtype=float) / mine["T0"].to_numpy(dtype=float)
+            ok = np.isfinite(T) & (T > 0)
+            raw, lab = log_spread(T), log_spread(eye(mine, t0_lab, "lab")["T"])
+            line += (f"{ok.sum()} slips, re-slips (T < 1e6 T0) {np.mean(T[ok] < RESLIP):.2f}, median T "
+                     f"{np.median(T[ok]):.2g} T0; std ln T {fmt(raw['std'], raw['std_error'], 2)} (bootstrap "
+                     f"{raw['std_error_bootstrap']:.2f}), robust {fmt(raw['robust'], raw['robust_error_bootstrap'], 2)}; "
+                     f"as the lab resolves them: {lab['slips']} slips, std ln T "
+                     f"{fmt(lab['std'], lab['std_error'], 2)} (bootstrap {lab['std_error_bootstrap']:.2f}), robust "
+                     f"{fmt(lab['robust'], lab['robust_error_bootstrap'], 2)}")
+            print(line)
+    print("- over seeds (n = 1):")
+    for lam, group in truth[truth["n"] == 1].groupby("strengthening"):
+        age, hold = over_seeds(group["B"], group["B_error"]), over_seeds(group["B_hold"], group["B_hold_error"])
+        print(f"  lambda {lam:g}: true B(age) {seeds_line(age)}; B(T_w) {seeds_line(hold)}; B(T_w) / B(age) "
+              f"{hold['mean'] / age['mean']:.2f}; seeds' sd {age['sd']:.4f}")
+    for lam, group in slips.groupby("strengthening"):
+        per = []
+        for _, mine in group.groupby("seed"):
+            T = (mine["T"] / mine["T0"]).to_numpy(dtype=float)
+            per.append((np.mean(T[np.isfinite(T)] < RESLIP), log_spread(T)["std"], log_spread(T)["robust"],
+                        log_spread(eye(mine, clocks[lam][0], "lab")["T"])["std"],
+                        log_spread(eye(mine, clocks[lam][0], "lab")["T"])["robust"]))
+        per = np.array(per)
+        names = ("re-slip share", "std ln T", "robust", "std ln T as resolved", "robust as resolved")
+        print(f"  lambda {lam:g}: " + "; ".join(f"{name} {seeds_line(over_seeds(per[:, k]), 2)}"
+                                                 for k, name in enumerate(names)))
+    return slips, clocks
+
+
+def _control_bend(runs, lam, seed):
+    chosen = runs[(runs["strengthening"] == lam) & (runs["seed"] == seed) & (runs["n"] == 1)]
+    if chosen.empty or chosen.iloc[0]["holds"] is None:
+        return math.nan, math.nan
+    item = chosen.iloc[0]["holds"]
+    peaks = peak_ages(first_peaks(item), item.tables["slip_events"])
+    return curvature(peaks.assign(hold_time=peaks["age"]), t_min=0.0)
+
+
+def clock_summary(clocks):
+    print(f"\n## 2. The lab's clock: one lab second (T0 = 1 s) in model time, from <ln(T / T0)> = {LAB_MEAN_LN} of the "
+          f"single slips the lab resolves (slips of an interface within {LAB_RESOLUTION:g} s merged), per lambda "
+          "(seeds pooled)")
+    for lam, (resolved, raw) in sorted(clocks.items()):
+        print(f"- lambda {lam:g}: 1 s = {resolved:.3g} / nu (resolution {LAB_RESOLUTION * resolved:.3g} / nu); "
+              f"without merging {raw:.3g} / nu")
+
+
+# --- 3. the estimator against the truth ------------------------------------------------------------------------------
+
+def seed_estimates(slips, clocks, by_n=False):
+    """Per (lambda, seed, clock, eye, fit): the paper's fit of the single slips."""
+    rows = []
+    for (lam, seed), mine in slips.groupby(["strengthening", "seed"]):
+        t0_lab = clocks[lam][0]
+        for which in EYES:
+            seen = eye(mine, t0_lab, which)
+            single = seen[~seen["multi"].to_numpy(dtype=bool)]
+            for clock, t0 in (("model", float(mine["T0"].iloc[0])), ("lab", t0_lab)):
+                for fit in FITS:
+                    result = estimate(single["T"], single["dmu"], t0=t0, fit=fit)
+                    rows.append({"strengthening": lam, "seed": seed, "clock": clock, "eye": which, "fit": fit,
+                                 "mean_ln": float(np.nanmean(np.log(single["T"] / t0))), **result})
+    return pd.DataFrame(rows)
+
+
+def estimator_summary(estimates, truth, title):
+    print(f"\n## 3. The paper's estimator against the true B: {title}")
+    for row in estimates.itertuples():
+        print(f"- lambda {row.strengthening:g}, seed {row.seed}, {row.clock} clock, {row.eye}, {row.fit}: B = "
+              f"{fmt(row.B, row.B_error)}, c = {fmt(row.c, row.c_error, 3)}; {row.slips} slips, {row.bins} bins, "
+              f"<ln T/T0> {row.mean_ln:.1f}, std ln T {row.std_lnT:.2f}" + (f" ({row.reason})" if row.reason else ""))
+    true = truth[truth["n"] == 1].set_index(["strengthening", "seed"])
+    print("- over seeds, against the true B (ratio of the seeds' means, error propagated from both; within 25 % if "
+          "its 95 % interval lies in 0.75-1.25):")
+    points = {}
+    for (clock, which, fit), part in estimates.groupby(["clock", "eye", "fit"]):
+        for lam, mine in part.groupby("strengthening"):
+            result = over_seeds(mine["B"], mine["B_error"])
+            keys = [(lam, s) for s in mine["seed"] if (lam, s) in true.index]
+            truth_seeds = over_seeds(true.loc[keys, "B"]) if keys else None
+            line = f"  {clock} clock, {which}, {fit}, lambda {lam:g}: B = {seeds_line(result)}"
+            if truth_seeds and lam > 0:
+                value, error = ratio(result["mean"], result["error"], truth_seeds["mean"], truth_seeds["error"])
+                low, high = value - 1.96 * error, value + 1.96 * error
+                verdict = "within 25 %" if 0.75 <= low and high <= 1.25 else (
+                    "outside 25 %" if high < 0.75 or low > 1.25 else "undecided")
+                line += f"; / true {fmt(value, error, 2)} [{low:.2f}, {high:.2f}] {verdict}"
+            print(line)
+            for seed_row in mine.itertuples():
+                if (lam, seed_row.seed) in true.index:
+                    t = true.loc[(lam, seed_row.seed)]
+                    points.setdefault((clock, which, fit), []).append((t["B"], t["B_error"], seed_row.B,
+                                                                        seed_row.B_error))
+    print("- the calibration line, estimate = intercept + slope x true B, over (lambda, seed) [95 % intervals]:")
+    for key, values in sorted(points.items()):
+        x, sx, y, sy = np.array(values).T
+        line = calibration_line(x, sx, y, sy)
+        print(f"  {key[0]} clock, {key[1]}, {key[2]}: slope {fmt(line['slope'], line['slope_error'], 2)} "
+              f"[{line['slope_low']:.2f}, {line['slope_high']:.2f}], intercept "
+              f"{fmt(line['intercept'], line['intercept_error'])} [{line['intercept_low']:.4f}, "
+              f"{line['intercept_high']:.4f}] ({line['points']} points)")
+
+
+# --- 4. the post-slip stress, 5. the stacks' truth ---------------------------------------------------------------------
+
+def post_slip_summary(slips):
+    print(f"\n## 4. The post-slip stress (peak - drop) of the slips after a reload (T >= {RELOAD:.0e} T0) against "
+          "ln T [sig0 per e-fold]")
+    for lam, group in slips.groupby("strengthening"):
+        per = [post_slip_slope(mine, RELOAD * float(mine["T0"].iloc[0])) for _, mine in group.groupby("seed")]
+        per = np.array(per)
+        print(f"- lambda {lam:g}: " + ", ".join(f"{fmt(s, e)} ({int(m)})" for s, e, m in per)
+              + f"; over seeds {seeds_line(over_seeds(per[:, 0], per[:, 1]))}")
+
+
+def stack_truth_summary(truth):
+    stacks = truth[(truth["n"] == 2) & truth["strength"].eq(1.0)]
+    if stacks.empty:
+        return
+    print("\n## 5. The true B per interface in the n = 2 stacks (paired holds 0 and 1e12 / nu until both slipped)")
+    for (lam, a), group in stacks.groupby(["strengthening", "interface"]):
+        print(f"- lambda {lam:g}, a = {a}: " + ", ".join(
+            f"seed {r.seed} {fmt(r.B, r.B_error)} ({r.states})" for r in group.itertuples())
+              + f"; over seeds {seeds_line(over_seeds(group['B'], group['B_error']))}")
+
+
+# --- 6. pooling, 7. the estimator beside the paper's -------------------------------------------------------------------
+
+def fits_line(slips, t0, label):
+    out = []
+    for fit in FITS:
+        r = estimate(slips["T"][~slips["multi"]], slips["dmu"][~slips["multi"]], t0=t0, fit=fit)
+        out.append(f"{label} {fit} {fmt(r['B'], r['B_error'])}")
+    return out
+
+
+def pooling_fem_summary(runs, truth):
+    slips = run_slips(runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05) & (runs["N"] == 162)])
+    slips = slips.assign(group=slips["strength"].astype(str) + "/" + slips["n"].astype(str))
+    strong = slips["run"].isin(slips.loc[slips["strength"] == 2.0, "run"])
+    partners = slips[strong | ((slips["n"] == 1) & slips["run"].isin(_weak_alone(runs)))]
+    if partners.empty:
+        return
+    print("\n## 6a. Pooling in the fem model: interfaces of strength 1 and 2 (alone, n = 1, and stacked, weak under "
+          "strong, n = 2), lambda 0 and 5, per seed; fits on T0 = 1 / nu")
+    table = []
+    for (lam, seed), mine in partners.groupby(["strengthening", "seed"]):
+        t0 = float(mine["T0"].iloc[0])
+        single = mine[~mine["multi"].to_numpy(dtype=bool)]
+        row = {"lambda": lam, "seed": seed}
+        for fit in FITS:
+            row[f"pooled {fit}"] = estimate(single["T"], single["dmu"], t0=t0, fit=fit)["B"]
+            for s, part in single.groupby("strength"):
+                row[f"strength {s:g} {fit}"] = estimate(part["T"], part["dmu"], t0=t0, fit=fit)["B"]
+        contrast = loading_contrast(mine, t0=t0, interface="strength")
+        row["contrast"], row["contrast error"] = contrast["B"], contrast["B_error"]
+        for s in (1.0, 2.0):
+            t = truth[(truth["strengthening"] == lam) & (truth["seed"] == seed) & (truth["n"] == 1)
+                      & (truth["strength"] == s)]
+            row[f"true {s:g}"] = float(t["B"].iloc[0]) if len(t) else math.nan
+        groups = single.groupby("group")
+        print(f"- lambda {lam:g}, seed {seed}: " + "; ".join(f"{k} {v:.4f}" for k, v in row.items()
+                                                              if k not in ("lambda", "seed"))
+              + "; per group (strength/n) mean drop, <ln T/T0>: " + ", ".join(
+                  f"{g} {p['dmu'].mean():.3f}, {np.log(p['T'] / t0).mean():.1f} ({len(p)})" for g, p in groups))
+        table.append(row)
+    table = pd.DataFrame(table)
+    print("- over seeds:")
+    for lam, part in table.groupby("lambda"):
+        print(f"  lambda {lam:g}: " + "; ".join(f"{k} {seeds_line(over_seeds(part[k]))}" for k in part
+                                                 if k not in ("lambda", "seed", "contrast error")))
+
+
+def _weak_alone(runs):
+    """The n = 1 runs of strength 1 whose seed and lambda have a stack of strengths (1, 2)."""
+    stacks = runs[runs["strength"].apply(lambda s: s == (1.0, 2.0))]
+    keys = set(zip(stacks["seed"], stacks["strengthening"]))
+    alone = runs[(runs["n"] == 1) & runs["strength"].apply(lambda s: s == (1.0,)) & runs["thermal"]
+                 & np.isclose(runs["phi"], PHI, rtol=0.05)]
+    return [r.run for r in alone.itertuples() if (r.seed, r.strengthening) in keys]
+
+
+def twin_slips(studies):
+    paths = sorted({Path(p).name: p for s in studies for p in glob.glob(
+        str(Path(s) / "events" / "experiment-events" / "rate-state-lever" / "*.h5"))}.values())
+    if not paths:
+        return pd.DataFrame()
+    slips = load_slips(paths)
+    slips = slips[slips["protocol"] == "stack"].copy()
+    b_of, a_of, pair = {}, {}, {}
+    for path in paths:
+        study = Path(path).parents[3]
+        truth = read_truth(study / "sim" / "rate-state-lever" / Path(path).name, "interfaces")
+        b_of[path], a_of[path] = dict(zip(truth["a"], truth["b"])), dict(zip(truth["a"], truth["a_rs"]))
+        with h5py.File(path, "r") as file:
+            params = json.loads(file.attrs["params"])
+        pair[path] = (tuple(params.get("rs_a", ())), tuple(params.get("rs_b", ())))
+    slips["b"] = [b_of[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
+    slips["a_rs"] = [a_of[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
+    slips["pair"] = [pair[f] for f in slips["file"]]
+    return slips
+
+
+def twin_summary(slips):
+    if slips.empty:
+        return
+    print("\n## 6b. Pooling in the rate-and-state twin (B = b by construction; T0 = 1 s): per (rs_a, rs_b) and seed, "
+          "the pooled fits over interfaces and n, the per-interface fits (mean over interfaces), the loading contrast")
+    for pair_, group in slips.groupby("pair"):
+        rows = []
+        for seed, mine in group.groupby("seed"):
+            single = mine[~mine["multi"].to_numpy(dtype=bool)]
+            row = {"seed": seed, "b": float(single["b"].mean())}
+            for fit in FITS:
+                row[f"pooled {fit}"] = estimate(single["T"], single["dmu"], t0=1.0, fit=fit)["B"]
+                per = [estimate(p["T"], p["dmu"], t0=1.0, fit=fit)["B"] for _, p in single.groupby("interface")]
+                row[f"per-interface {fit}"] = float(np.nanmean(per))
+            contrast = loading_contrast(mine, t0=1.0)
+            row["contrast"], row["b - a"] = contrast["B"], float((single["b"] - single["a_rs"]).mean())
+            rows.append(row)
+        rows = pd.DataFrame(rows)
+        drops = group[~group["multi"] & (group["n"] == group["interface"])].groupby("interface")["dmu"].mean()
+        print(f"- rs_a {list(pair_[0]) or 'default'}, rs_b {list(pair_[1]) or 'default'}: {group['file'].nunique()} "
+              f"runs, {len(group)} slips; mean drop of interface a in the stack n = a: "
+              + ", ".join(f"{d:.3f}" for d in drops))
+        for column in rows:
+            if column != "seed":
+                stats_ = over_seeds(rows[column])
+                line = f"  {column}: {seeds_line(stats_)}"
+                if column not in ("b", "b - a"):
+                    line += f"; / b {stats_['mean'] / rows['b'].mean():.2f}"
+                print(line)
+
+
+def synthetic_pooling_summary():
+    print("\n## 6c. Pooling on synthetic slips (stickslip.statistics.estimator.lab_slips): the paper's strengths "
+          "0.15-0.3 (5 interfaces), its loading rates (n + a)(n - a + 1) / 2, n = 1 ... 5 (15 groups), thresholds' "
+          "CV 0.1, path spread 0.5 in stacks, 300 slips per group, 10 seeds; the paper: "
+          f"{PAPER_B} ± {PAPER_B_ERROR}")
+    for B in (0.0, 0.02):
+        for order, strengths in (("rising", np.linspace(0.15, 0.3, 5)), ("falling", np.linspace(0.3, 0.15, 5))):
+            rows = []
+            for seed in range(10):
+                slips = lab_slips(np.random.default_rng(seed), 300, B=B, strengths=strengths, disorder=0.1,
+                                  path_spread=0.5)
+                single = slips[~slips["multi"]]
+                row = {}
+                for fit in FITS:
+                    row[f"pooled {fit}"] = estimate(single["T"], single["dmu"], t0=1.0, fit=fit)["B"]
+                    row[f"per-interface {fit}"] = float(np.nanmean(
+                        [estimate(p["T"], p["dmu"], t0=1.0, fit=fit)["B"] for _, p in single.groupby("interface")]))
+                row["contrast"] = loading_contrast(slips, t0=1.0)["B"]
+                row["<ln T>"] = float(np.log(single["T"]).mean())
+                rows.append(row)
+            rows = pd.DataFrame(rows)
+            print(f"- true B {B:g}, strength {order} with a: " + "; ".join(
+                f"{k} {seeds_line(over_seeds(rows[k]))}" for k in rows))
+
+
+def contrast_fem_summary(slips, truth):
+    print("\n## 7. The estimator beside the paper's (loading contrast: per interface, the stacks' mean drops against "
+          "their mean ln T) against the true B, fem: interface 1 alone (n = 1) and in the n = 2 stack, same seed")
+    rows = []
+    for (lam, seed), mine in slips.groupby(["strengthening", "seed"]):
+        if mine["n"].nunique() < 2:
+            continue
+        t0 = float(mine["T0"].iloc[0])
+        result = loading_contrast(mine[mine["interface"] == 1], t0=t0)
+        t = truth[(truth["strengthening"] == lam) & (truth["seed"] == seed) & (truth["n"] == 1)]
+        true = float(t["B"].iloc[0]) if len(t) else math.nan
+        print(f"- lambda {lam:g}, seed {seed}: B = {fmt(result['B'], result['B_error'])} (<ln T> apart by "
+              f"{result['lnT_range']:.2f}); true {true:.4f}")
+        rows.append({"lambda": lam, "B": result["B"], "error": result["B_error"], "true": true})
+    for lam, part in pd.DataFrame(rows).groupby("lambda") if rows else []:
+        est, tr = over_seeds(part["B"], part["error"]), over_seeds(part["true"])
+        print(f"  over seeds, lambda {lam:g}: {seeds_line(est)}; true {seeds_line(tr)}")
+
+
+# --- 8. the pre-check ----------------------------------------------------------------------------------------------
+
+def precheck_summary(runs, studies):
+    athermal = runs[~runs["thermal"] & (runs["drive"] == "fixed-lever") & (runs["phi"] < 1e-8)]
+    if athermal.empty:
+        return
+    print(f"\n## 8. The decisive drive's pre-check (athermal, T_a = drive since the previous slip): n = 1 narrow "
+          f"(robust spread of ln T <= {NARROW}), n >= 3 broad by the lever (>= {BROAD} per interface, other slips "
+          f"taking >= {INTERRUPTED} of its loading)")
+    for (N, phi, n), group in athermal.groupby(["N", "phi", "n"]):
+        parts = []
+        for _, run in group.iterrows():
+            slips = run["data"].tables["slip_events"]
+            parts.append(slips.assign(seed=run["seed"]))
+        slips = pd.concat(parts, ignore_index=True)
+        study = Path(group["file"].iloc[0]).parents[3]
+        rates = loading_rates(study / "sim" / "fem" / f"{group['run'].iloc[0]}.h5")
+        for a, mine in slips.groupby("interface"):
+            spread_ = log_spread(mine["wait_drive"])
+            share = (mine["interrupted_sig0"] / mine["rise_sig0"]).replace([np.inf, -np.inf], np.nan)
+            cv = mine["dmu_sig0"].std() / mine["dmu_sig0"].mean()
+            per_seed = [log_spread(p["wait_drive"])["robust"] for _, p in mine.groupby("seed")]
+            print(f"- N {N}, Phi {phi:.0e}, n {n}, a = {a}: {spread_['slips']} slips ({group['seed'].nunique()} seeds, "
+                  f"{len(mine) / group['seed'].nunique():.0f} per seed); std ln T {fmt(spread_['std'], spread_['std_error_bootstrap'], 2)}, "
+                  f"robust {fmt(spread_['robust'], spread_['robust_error_bootstrap'], 2)} (per seed "
+                  f"{', '.join(f'{v:.2f}' for v in per_seed)}); interrupted share {np.nanmean(share):.2f}; CV of the "
+                  f"drop {cv:.2f}, median drop {mine['dmu_sig0'].median():.3f} sig0; loading rate {rates[a - 1]:.4g} "
+                  "sig0 per eps0")
+
+
+# --- 9. the cost -----------------------------------------------------------------------------------------------------
+
+def cost_summary(studies, runs):
+    print("\n## 9. The cost: CPU seconds of every simulation (Snakemake's benchmark files; wall s in brackets), and "
+          "the events jobs' wall time from the Snakemake log")
+    label = {r.run: f"N {r.N}, n {r.n}, Phi {r.phi:.0e}" + (f", lambda {r.strengthening:g}" if r.thermal else "")
+             + (f", strength {','.join(f'{s:g}' for s in r.strength)}" if any(s != 1 for s in r.strength) else "")
+             + f", seed {r.seed}" for r in runs.itertuples()}
+    for study in studies:
+        rows = []
+        for path in sorted(Path(study, "logs", "benchmarks", "sim").glob("*/*.tsv")):
+            table = pd.read_csv(path, sep="\t")
+            rows.append((label.get(path.stem, path.parent.name), float(table["cpu_time"].iloc[-1]),
+                         float(table["s"].iloc[-1])))
+        if not rows:
+            continue
+        print(f"- {study}: {len(rows)} simulations, {sum(r[1] for r in rows) / 60:.0f} CPU-min")
+        for name, cpu, wall in sorted(rows):
+            print(f"  {name}: {cpu:.0f} CPU-s ({wall:.0f} s)")
+        for name, minutes in _events_minutes(study, label):
+            print(f"  events {name}: {minutes:.1f} min")
+
+
+def _events_minutes(study, label):
+    """The wall time of every events job with hold trials, from the study's last Snakemake log in logs56/ or
+    .snakemake/log (Snakemake's own timestamps)."""
+    logs = sorted(Path(study).parent.parent.glob(f"logs56/{Path(study).name}.log"))
+    if not logs:
+        return []
+    jobs, current, stamp = {}, None, None
+    for line in logs[-1].read_text().splitlines():
+        if line.startswith("[") and line.endswith("]"):
+            stamp = pd.to_datetime(line[1:-1], format="%a %b %d %H:%M:%S %Y", errors="coerce")
+        elif match := re.match(r"\s+jobid: (\d+)", line):
+            current = match.group(1)
+            jobs[current] = {"start": stamp}
+        elif (match := re.match(r"\s+wildcards: analysis=(thermal-events[^,]*), solver=fem, run_id=(\w+)", line)) \
+                and current:
+            jobs[current]["name"] = f"{match.group(1)} {label.get(match.group(2), match.group(2))}"
+        elif match := re.match(r"Finished jobid: (\d+)", line):
+            if match.group(1) in jobs:
+                jobs[match.group(1)]["end"] = stamp
+    return sorted((job["name"], (job["end"] - job["start"]).total_seconds() / 60) for job in jobs.values()
+                  if "name" in job and "end" in job)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("studies", nargs="+", help="results directories (e.g. results/calibration)")
+    args = parser.parse_args(argv)
+    warnings.simplefilter("ignore", RuntimeWarning)
+    runs = load_calibration_runs(args.studies)
+    calibration = calibration_runs(runs)
+    truth = truth_table(runs[runs["thermal"]])
+    if not calibration.empty:
+        cal_truth = truth[truth["strength"] == 1.0]
+        slips, clocks = truth_summary(calibration, cal_truth)
+        clock_summary(clocks)
+        alone = slips[slips["n"] == 1]
+        estimator_summary(seed_estimates(alone, clocks), cal_truth, "n = 1 slips, per lambda and seed")
+        both = slips[slips["strengthening"].isin(slips.loc[slips["n"] == 2, "strengthening"].unique())]
+        both = both[both["seed"].isin(both.loc[both["n"] == 2, "seed"].unique())]
+        if both["n"].nunique() > 1:
+            estimator_summary(seed_estimates(both, clocks), cal_truth,
+                              "n = 1 and 2 pooled (the dissonance study's pool)")
+        post_slip_summary(alone)
+        stack_truth_summary(cal_truth)
+        contrast_fem_summary(slips, cal_truth)
+    pooling_fem_summary(runs, truth)
+    twin_summary(twin_slips(args.studies))
+    synthetic_pooling_summary()
+    precheck_summary(runs, args.studies)
+    cost_summary(args.studies, runs)
+
+
+if __name__ == "__main__":
+    main()
