@@ -2,7 +2,7 @@
 dissonance" (issue 56).
 
     python benchmarks/calibration_findings.py results/calibration results/calibration-b \\
-        results/calibration-stacks results/pooling results/drive-precheck
+        results/calibration-stacks results/pooling results/pooling-twin results/drive-precheck
 
 Reads the studies of workflow/config/calibration.yaml, calibration-b.yaml (the thermal n = 1 runs at Phi = 5e-9, 4
 lambda, seeds 1-5), calibration-stacks.yaml (n = 2, lambda 0 and 5, seeds 1-3), pooling.yaml (interfaces of
