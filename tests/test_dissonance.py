@@ -306,3 +306,37 @@ def test_the_compliant_limit_has_the_labs_loading_rates_within_a_fifth_at_n_162(
         model = _lever_sums(build_stack_mesh(MeshParams(N=162, plates=n + 1))) / reference
         lab = np.array([(n + a) * (n - a + 1) / 2 for a in range(1, n + 1)])
         assert np.all(np.abs(model / lab - 1) < 0.2) and abs(model[0] / lab[0] - 1) < 0.05, n
+
+
+@pytest.mark.slow
+def test_the_calibration_summary_reads_each_runs_truth_and_slips_from_its_studies(held, tmp_path):
+    """The calibration's runs of two studies (one run in both is read once): its true B is the paired holds' slope
+    against the age at the peak, its slips the waiting-times table's, its strengths 1."""
+    import shutil
+
+    from stickslip.events.analysis_files import read_analysis_file
+    from stickslip.summaries.aging_summary import first_peaks, paired_slopes
+    from stickslip.summaries.calibration_summary import load_calibration_runs, run_slips, run_truth
+    from stickslip.summaries.dissonance_summary import peak_ages
+
+    studies = [tmp_path / "one", tmp_path / "two"]
+    for study, strengthenings in zip(studies, ((20.0, 0.0), (20.0,))):
+        for strengthening in strengthenings:
+            for name in ("waiting-times", "thermal-events"):
+                target = study / "events" / name / "fem" / f"run{strengthening:g}.h5"
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy(held[strengthening][name], target)
+    runs = load_calibration_runs(studies)
+    assert sorted(runs["run"]) == ["run0", "run20"] and set(runs["study"]) == {str(studies[0])}
+    assert runs["strength"].tolist() == [(1.0,), (1.0,)] and runs["N"].tolist() == [54, 54]
+    for _, run in runs.iterrows():
+        item = read_analysis_file(held[run["strengthening"]]["thermal-events"], "event-table",
+                                  ("slip_events", "holds", "trial_slips"))
+        expected = paired_slopes(peak_ages(first_peaks(item), item.tables["slip_events"]), t_min=0.0, time="age")
+        truth = run_truth(run["holds"]).iloc[0]
+        assert (truth["B"], truth["B_error"], truth["states"]) == pytest.approx(expected, nan_ok=True)
+    slips = run_slips(runs)
+    waits = read_analysis_file(held[20.0]["waiting-times"], "event-table", ("slip_events",)).tables["slip_events"]
+    mine = slips[slips["run"] == "run20"]
+    assert np.array_equal(mine["T"], waits["T_fe"], equal_nan=True) and np.array_equal(mine["dmu"], waits["dmu_sig0"])
+    assert (mine["strength"] == 1.0).all() and (mine["T0"] == 1.0).all()
