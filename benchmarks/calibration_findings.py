@@ -68,9 +68,10 @@ def fmt(value, error, digits=4):
 
 
 def seeds_line(stats_, digits=4):
-    """'mean ± between [low, high] (within; k seeds)'."""
+    """'mean ± between [low, high] (within w; k seeds)' (no within-seed error where the values have none)."""
+    within = f"within {stats_['within']:.{digits}f}; " if math.isfinite(stats_["within"]) else ""
     return (f"{fmt(stats_['mean'], stats_['error'], digits)} [{stats_['low']:.{digits}f}, {stats_['high']:.{digits}f}]"
-            f" (within {stats_['within']:.{digits}f}; {stats_['seeds']} seeds)")
+            f" ({within}{stats_['seeds']} seeds)")
 
 
 def calibration_runs(runs):
