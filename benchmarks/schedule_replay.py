@@ -1,6 +1,6 @@
 """How long a study takes on few cores under a scheduling policy: its jobs' measured times replayed.
 
-    python benchmarks/schedule_replay.py SNAKEMAKE_LOG --configfile CONFIG [--cores 2] [--orders 40]
+    python benchmarks/schedule_replay.py SNAKEMAKE_LOG --configfile CONFIG [--cores 2] [--orders 40] [--cpu STUDY]
 
 Reads the start and end of every job from the log of a Snakemake run (``snakemake --cores 2 ... > LOG 2>&1``), then
 replays the jobs on ``--cores`` cores by list scheduling: whenever a core is free, the ready job (its run stored,
@@ -10,6 +10,9 @@ the workflow's for the study of ``CONFIG`` (:meth:`stickslip.study_plan.Study.ru
 :data:`stickslip.study_plan.ANALYSIS_PRIORITY`). Prints the measured wall time, the jobs' summed time over
 the cores (no schedule is shorter) and each policy's least, median and largest wall time [min]. The replay assumes
 a job takes as long as it did in the log whatever runs beside it; a meshing job (seconds) is not waited for.
+With ``--cpu STUDY`` (the study's results directory) a job takes its CPU time instead, from Snakemake's benchmark
+files of the runs and analyses where the study has them (a job on an idle core of a single-threaded study takes its
+CPU time: the wall time of a fresh clone on a quiet machine, where the logged times carry other users' load).
 """
 
 import argparse
@@ -42,6 +45,8 @@ def read_jobs(log):
             jobs[current] = {"rule": rule, "solver": None, "run_id": None, "start": stamp}
         elif (match := re.match(r"\s+wildcards: .*solver=([\w-]+), run_id=(\w+)", line)) and current:
             jobs[current]["solver"], jobs[current]["run_id"] = match.groups()
+            if analysis := re.search(r"analysis=([\w@-]+)", line):
+                jobs[current]["analysis"] = analysis.group(1)
         elif match := re.match(r"Finished jobid: (\d+)", line):
             jobs[match.group(1)]["end"] = stamp
     return {key: job for key, job in jobs.items() if "end" in job}
@@ -74,12 +79,32 @@ def replay(jobs, cores, priority, rank):
     return now
 
 
+def cpu_durations(jobs, study):
+    """Replace the duration of every simulate and events job with its benchmark file's CPU time [s], where there is one
+    (``STUDY/logs/benchmarks/{sim,events/<analysis>}/<solver>/<run_id>.tsv``); returns how many were replaced."""
+    replaced = 0
+    for job in jobs.values():
+        if job["rule"] == "simulate":
+            path = Path(study, "logs", "benchmarks", "sim", str(job["solver"]), f"{job['run_id']}.tsv")
+        elif job["rule"] == "events":
+            path = Path(study, "logs", "benchmarks", "events", str(job["analysis"]), str(job["solver"]),
+                        f"{job['run_id']}.tsv")
+        else:
+            continue
+        if path.exists():
+            lines = path.read_text().splitlines()
+            job["duration"] = float(lines[-1].split("\t")[lines[0].split("\t").index("cpu_time")])
+            replaced += 1
+    return replaced
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("log", help="the log of a Snakemake run (its standard output and error)")
     parser.add_argument("--configfile", required=True, help="the study's config (the one the log's run had)")
     parser.add_argument("--cores", type=int, default=2)
     parser.add_argument("--orders", type=int, default=40, help="random orders of the jobs of equal priority")
+    parser.add_argument("--cpu", help="the study's results directory: jobs take their CPU time (module docstring)")
     args = parser.parse_args(argv)
     jobs = read_jobs(args.log)
     if not jobs:
@@ -88,6 +113,8 @@ def main(argv=None):
     start = min(job["start"] for job in jobs.values())
     for job in jobs.values():
         job["duration"] = (job["end"] - job["start"]).total_seconds()
+    if args.cpu:
+        print(f"CPU times of {cpu_durations(jobs, args.cpu)} of the {len(jobs)} jobs from {args.cpu}")
     unknown = sorted({f"{job['solver']}/{job['run_id']}" for job in jobs.values() if job["rule"] == "simulate"}
                      - {f"{sim.solver}/{sim.run_id}" for sim in study.simulations})
     if unknown:

@@ -60,6 +60,7 @@ PATHS = {
     "database": "stickslip.sqlite",
     "logs": "logs",
     "benchmark": "logs/benchmarks/sim/{solver}/{run_id}.tsv",
+    "events_benchmark": "logs/benchmarks/events/{analysis}/{solver}/{run_id}.tsv",
 }
 
 _STUDY_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")

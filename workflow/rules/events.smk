@@ -10,6 +10,8 @@ rule events:
         record=record_of(STUDY.path("events")),
     log:
         STUDY.log("events/{analysis}/{solver}/{run_id}"),
+    benchmark:
+        STUDY.path("events_benchmark")
     params:
         params=lambda wildcards: Study.dumps(STUDY.analyses[wildcards.analysis]),
         simulation=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).artifact()),
