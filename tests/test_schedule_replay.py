@@ -41,3 +41,19 @@ def test_the_replay_reads_the_log_and_puts_the_long_chain_first(tmp_path):
     first = {"3": 1, "4": 2}
     assert schedule_replay.replay(jobs, 2, lambda key: first.get(key, 0), logged) == 161.0
     assert schedule_replay.replay(jobs, 1, lambda key: 0, logged) == 281.0  # one core: the jobs' sum
+
+
+def test_the_jobs_take_their_cpu_time_where_the_study_has_benchmark_files(tmp_path):
+    log = tmp_path / "snakemake.log"
+    log.write_text(snakemake_log(JOBS))
+    jobs = schedule_replay.read_jobs(log)
+    for job in jobs.values():
+        job["duration"] = (job["end"] - job["start"]).total_seconds()
+    header = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    for path, cpu in (("sim/fem/tttt.tsv", 30.5), ("events/thermal-events/fem/tttt.tsv", 12.25)):
+        target = tmp_path / "study" / "logs" / "benchmarks" / path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(header + f"99.0\t0:01:39\t1\t1\t1\t1\t0\t0\t50\t{cpu}\n")
+    assert schedule_replay.cpu_durations(jobs, tmp_path / "study") == 2
+    assert [job["duration"] for job in jobs.values()] == [60.0, 60.0, 30.5, 12.25, 1.0]
+    assert jobs["4"]["analysis"] == "thermal-events"
