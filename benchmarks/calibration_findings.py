@@ -482,8 +482,10 @@ def main(argv=None):
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore", RuntimeWarning)
     runs = load_calibration_runs(args.studies)
+    if runs.empty:
+        runs = runs.assign(thermal=[], phi=[], strength=[])
     calibration = calibration_runs(runs)
-    truth = truth_table(runs[runs["thermal"]])
+    truth = truth_table(runs[runs["thermal"].astype(bool)])
     if not calibration.empty:
         cal_truth = truth[truth["strength"] == 1.0]
         slips, clocks = truth_summary(calibration, cal_truth)
@@ -498,10 +500,12 @@ def main(argv=None):
         post_slip_summary(alone)
         stack_truth_summary(cal_truth)
         contrast_fem_summary(slips, cal_truth)
-    pooling_fem_summary(runs, truth)
+    if not runs.empty:
+        pooling_fem_summary(runs, truth)
     twin_summary(twin_slips(args.studies))
     synthetic_pooling_summary()
-    precheck_summary(runs, args.studies)
+    if not runs.empty:
+        precheck_summary(runs, args.studies)
     cost_summary(args.studies, runs)
 
 
