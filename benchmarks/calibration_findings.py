@@ -409,6 +409,7 @@ def precheck_summary(runs, studies):
     print(f"\n## 8. The decisive drive's pre-check (athermal, T_a = drive since the previous slip): n = 1 narrow "
           f"(robust spread of ln T <= {NARROW}), n >= 3 broad by the lever (>= {BROAD} per interface, other slips "
           f"taking >= {INTERRUPTED} of its loading)")
+    verdicts = {}
     for (N, phi, n), group in athermal.groupby(["N", "phi", "n"]):
         parts = []
         for _, run in group.iterrows():
@@ -422,12 +423,18 @@ def precheck_summary(runs, studies):
             share = (mine["interrupted_sig0"] / mine["rise_sig0"]).replace([np.inf, -np.inf], np.nan)
             cv = mine["dmu_sig0"].std() / mine["dmu_sig0"].mean()
             per_seed = [log_spread(p["wait_drive"])["robust"] for _, p in mine.groupby("seed")]
+            ok = spread_["robust"] <= NARROW if n == 1 else (
+                spread_["std"] >= BROAD and np.nanmean(share) >= INTERRUPTED)
+            verdicts.setdefault((N, phi), []).append(bool(ok))
             print(f"- N {N}, Phi {phi:.0e}, n {n}, a = {a}: {spread_['slips']} slips ({group['seed'].nunique()} seeds, "
                   f"{len(mine) / group['seed'].nunique():.0f} per seed); std ln T {fmt(spread_['std'], spread_['std_error_bootstrap'], 2)}, "
                   f"robust {fmt(spread_['robust'], spread_['robust_error_bootstrap'], 2)} (per seed "
                   f"{', '.join(f'{v:.2f}' for v in per_seed)}); interrupted share {np.nanmean(share):.2f}; CV of the "
                   f"drop {cv:.2f}, median drop {mine['dmu_sig0'].median():.3f} sig0; loading rate {rates[a - 1]:.4g} "
-                  "sig0 per eps0")
+                  f"sig0 per eps0; {'meets' if ok else 'fails'} its criterion")
+    for (N, phi), oks in sorted(verdicts.items()):
+        print(f"- go/no-go, N {N}, Phi {phi:.0e}: {'go' if all(oks) else 'no-go'} ({sum(oks)} of {len(oks)} "
+              "interface criteria met)")
 
 
 # --- 9. the cost -----------------------------------------------------------------------------------------------------
