@@ -134,8 +134,10 @@ def truth_summary(runs, truth):
     print("- over seeds (n = 1):")
     for lam, group in truth[truth["n"] == 1].groupby("strengthening"):
         age, hold = over_seeds(group["B"], group["B_error"]), over_seeds(group["B_hold"], group["B_hold_error"])
+        bends = np.array([_control_bend(runs, lam, seed) for seed in group["seed"]])
         print(f"  lambda {lam:g}: true B(age) {seeds_line(age)}; B(T_w) {seeds_line(hold)}; B(T_w) / B(age) "
-              f"{hold['mean'] / age['mean']:.2f}; seeds' sd {age['sd']:.4f}")
+              f"{hold['mean'] / age['mean']:.2f}; seeds' sd {age['sd']:.4f}; curvature in ln age "
+              f"{seeds_line(over_seeds(bends[:, 0], bends[:, 1]), 5)}")
     for lam, group in slips.groupby("strengthening"):
         per = []
         for _, mine in group.groupby("seed"):
