@@ -132,12 +132,17 @@ def truth_summary(runs, truth):
                      f"{fmt(lab['robust'], lab['robust_error_bootstrap'], 2)}")
             print(line)
     print("- over seeds (n = 1):")
+    base = truth[(truth["n"] == 1) & (truth["strengthening"] == 5.0)]
+    reference = over_seeds(base["B"]) if len(base) else None
     for lam, group in truth[truth["n"] == 1].groupby("strengthening"):
         age, hold = over_seeds(group["B"], group["B_error"]), over_seeds(group["B_hold"], group["B_hold_error"])
         bends = np.array([_control_bend(runs, lam, seed) for seed in group["seed"]])
         print(f"  lambda {lam:g}: true B(age) {seeds_line(age)}; B(T_w) {seeds_line(hold)}; B(T_w) / B(age) "
               f"{hold['mean'] / age['mean']:.2f}; seeds' sd {age['sd']:.4f}; curvature in ln age "
-              f"{seeds_line(over_seeds(bends[:, 0], bends[:, 1]), 5)}")
+              f"{seeds_line(over_seeds(bends[:, 0], bends[:, 1]), 5)}; seeds' values "
+              + ", ".join(f"{v:.4f}" for v in group["B"])
+              + (f"; / lambda 5 {fmt(*ratio(age['mean'], age['error'], reference['mean'], reference['error']), 2)}"
+                 if reference else ""))
     for lam, group in slips.groupby("strengthening"):
         per = []
         for _, mine in group.groupby("seed"):
