@@ -134,7 +134,7 @@ def truth_summary(runs, truth):
     print("- over seeds (n = 1):")
     base = truth[(truth["n"] == 1) & (truth["strengthening"] == 5.0)]
     reference = over_seeds(base["B"]) if len(base) else None
-    for lam, group in truth[truth["n"] == 1].groupby("strengthening"):
+    for lam, group in truth[truth["n"] == 1].sort_values("seed").groupby("strengthening"):
         age, hold = over_seeds(group["B"], group["B_error"]), over_seeds(group["B_hold"], group["B_hold_error"])
         bends = np.array([_control_bend(runs, lam, seed) for seed in group["seed"]])
         print(f"  lambda {lam:g}: true B(age) {seeds_line(age)}; B(T_w) {seeds_line(hold)}; B(T_w) / B(age) "
