@@ -447,8 +447,8 @@ def precheck_summary(runs, studies):
 # --- 9. the cost -----------------------------------------------------------------------------------------------------
 
 def cost_summary(studies, runs):
-    print("\n## 9. The cost: CPU seconds of every simulation (Snakemake's benchmark files; wall s in brackets), and "
-          "the events jobs' wall time from the Snakemake log")
+    print("\n## 9. The cost: CPU seconds of every simulation and analysis (Snakemake's benchmark files; wall s in "
+          "brackets; where a study's analyses have none, their wall time from its Snakemake log)")
     label = {r.run: f"N {r.N}, n {r.n}, Phi {r.phi:.0e}" + (f", lambda {r.strengthening:g}" if r.thermal else "")
              + (f", strength {','.join(f'{s:g}' for s in r.strength)}" if any(s != 1 for s in r.strength) else "")
              + f", seed {r.seed}" for r in runs.itertuples()}
@@ -463,8 +463,17 @@ def cost_summary(studies, runs):
         print(f"- {study}: {len(rows)} simulations, {sum(r[1] for r in rows) / 60:.0f} CPU-min")
         for name, cpu, wall in sorted(rows):
             print(f"  {name}: {cpu:.0f} CPU-s ({wall:.0f} s)")
-        for name, minutes in _events_minutes(study, label):
-            print(f"  events {name}: {minutes:.1f} min")
+        events = sorted(Path(study, "logs", "benchmarks", "events").glob("*/*/*.tsv"))
+        for path in events:
+            table = pd.read_csv(path, sep="\t")
+            print(f"  events {path.parts[-3]} {label.get(path.stem, path.stem)}: {table['cpu_time'].iloc[-1]:.0f} CPU-s "
+                  f"({table['s'].iloc[-1]:.0f} s)")
+        if events:
+            total = sum(float(pd.read_csv(path, sep="\t")["cpu_time"].iloc[-1]) for path in events)
+            print(f"  events jobs: {total / 60:.0f} CPU-min in {len(events)} jobs")
+        else:  # a study run before the analyses had benchmark files: their wall time from the Snakemake log
+            for name, minutes in _events_minutes(study, label):
+                print(f"  events {name}: {minutes:.1f} min of wall time")
 
 
 def _events_minutes(study, label):
