@@ -26,7 +26,9 @@ them: the root mean square of the seeds' own errors over ``sqrt(k)``):
 7. the estimator beside the paper's (:mod:`stickslip.statistics.loading_contrast`) against the truth: fem and twin;
 8. the pre-check of the decisive drive: std ln T_a per interface, its robust spread, the share of the loading that
    other slips take, against the criteria, per N, Phi and n; the go/no-go;
-9. the cost: CPU seconds of every simulation and the wall time of the events jobs, per study.
+9. the cost: CPU seconds of every simulation and the wall time of the events jobs, per study;
+10. the cost of the configs not run here (:data:`PLANNED`) from the CPU seconds per increment and per hold state
+    measured here.
 """
 
 import argparse
@@ -40,6 +42,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pandas as pd
+import yaml
 
 from stickslip.experiment.timeseries import read_truth
 from stickslip.figures.experimental_data import load_slips
@@ -50,6 +53,7 @@ from stickslip.statistics.loading_contrast import loading_contrast
 from stickslip.summaries.aging_summary import curvature, first_peaks, ratio
 from stickslip.summaries.calibration_summary import load_calibration_runs, post_slip_slope, run_slips, run_truth
 from stickslip.summaries.dissonance_summary import loading_rates, peak_ages
+from stickslip.study_plan import Study
 
 #: The broad drive of the calibration (Phi = 5e-9) and the split of its waiting times: thermal re-slips below
 #: RESLIP, slips after a reload above RELOAD [1 / nu].
@@ -77,7 +81,7 @@ def seeds_line(stats_, digits=4):
 def calibration_runs(runs):
     """The calibration's thermal runs at the broad drive with every interface of strength 1."""
     plain = runs["strength"].apply(lambda s: all(v == 1.0 for v in s))
-    return runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05) & plain & (runs["N"] == 162)]
+    return runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05, atol=0.0) & plain & (runs["N"] == 162)]
 
 
 def truth_table(runs):
@@ -266,7 +270,7 @@ def fits_line(slips, t0, label):
 
 
 def pooling_fem_summary(runs, truth):
-    slips = run_slips(runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05) & (runs["N"] == 162)])
+    slips = run_slips(runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05, atol=0.0) & (runs["N"] == 162)])
     slips = slips.assign(group=slips["strength"].astype(str) + "/" + slips["n"].astype(str))
     strong = slips["run"].isin(slips.loc[slips["strength"] == 2.0, "run"])
     partners = slips[strong | ((slips["n"] == 1) & slips["run"].isin(_weak_alone(runs)))]
@@ -307,7 +311,7 @@ def _weak_alone(runs):
     stacks = runs[runs["strength"].apply(lambda s: s == (1.0, 2.0))]
     keys = set(zip(stacks["seed"], stacks["strengthening"]))
     alone = runs[(runs["n"] == 1) & runs["strength"].apply(lambda s: s == (1.0,)) & runs["thermal"]
-                 & np.isclose(runs["phi"], PHI, rtol=0.05)]
+                 & np.isclose(runs["phi"], PHI, rtol=0.05, atol=0.0)]
     return [r.run for r in alone.itertuples() if (r.seed, r.strengthening) in keys]
 
 
@@ -499,6 +503,74 @@ def _events_minutes(study, label):
                   if "name" in job and "end" in job)
 
 
+# --- 10. the planned configs' cost -----------------------------------------------------------------------------------
+
+#: The configs not run here whose cost section 10 projects.
+PLANNED = ("workflow/config/calibration-stacks.yaml", "workflow/config/pooling.yaml", "workflow/config/pilot-probe.yaml",
+           "workflow/config/dissonance-pilot.yaml", "workflow/config/dissonance-paper.yaml")
+
+
+def _cpu(study, kind, run):
+    """The CPU seconds of one job from Snakemake's benchmark file (NaN where it has none)."""
+    paths = sorted(Path(study, "logs", "benchmarks", kind).glob(f"**/{run}.tsv"))
+    return float(pd.read_csv(paths[0], sep="\t")["cpu_time"].iloc[-1]) if paths else math.nan
+
+
+def per_increment(runs):
+    """Per run: CPU seconds per increment of its simulation and per hold state of its thermal-events job."""
+    rows = []
+    for r in runs.itertuples():
+        params = r.data.attrs.get("params", {})
+        holds = r.holds.attrs["analysis_params"].get("states", math.nan) if r.holds is not None else math.nan
+        rows.append({"N": r.N, "n": r.n, "phi": r.phi, "thermal": bool(r.thermal), "lam": r.strengthening,
+                     "sim": _cpu(r.study, "sim", r.run) / int(params.get("max_increments", 1)),
+                     "state": _cpu(r.study, "events/thermal-events", r.run) / holds})
+    return pd.DataFrame(rows)
+
+
+def _mean_rate(rates, **equal):
+    """The mean CPU seconds per increment of the runs whose columns equal ``equal``."""
+    return float(rates.loc[np.logical_and.reduce([rates[k] == v for k, v in equal.items()]), "sim"].mean())
+
+
+def planned_cost_summary(runs, configs=PLANNED):
+    """Section 10: the CPU time of the planned configs from the per-increment times measured here."""
+    rates = per_increment(runs)
+    athermal = rates[~rates["thermal"] & np.isclose(rates["phi"], PHI, rtol=0.05, atol=0.0) & rates["sim"].notna()]
+    thermal = rates[rates["thermal"] & np.isclose(rates["phi"], PHI, rtol=0.05, atol=0.0) & (rates["N"] == 162)
+                    & rates["sim"].notna()]
+    size = _mean_rate(athermal, N=162, n=1) / _mean_rate(athermal, N=54, n=1)
+    stack = {N: _mean_rate(athermal, N=N, n=3) / _mean_rate(athermal, N=N, n=1) for N in (54, 162)}
+    if not (math.isfinite(size) and thermal["lam"].nunique()):
+        return
+    print("\n## 10. The planned configs' cost, from the CPU time per increment measured here (section 9)")
+    print(f"- athermal, Phi = 5e-9: N = 162 / N = 54 per increment (n = 1) {size:.2f} (N = 486 taken as N = 162 times "
+          f"the same factor); n = 3 / n = 1 " + ", ".join(f"{v:.2f} at N = {N}" for N, v in stack.items())
+          + " (other n: the n = 3 factor times n / 3)")
+    f3 = stack[162] if math.isfinite(stack[162]) else stack[54]
+    per_lam = thermal[thermal["n"] == 1].groupby("lam")[["sim", "state"]].mean()
+    print("- thermal, N = 162, n = 1: CPU-s per increment, per hold state: " + "; ".join(
+        f"lambda {lam:g} {row.sim:.3f}, {row.state:.1f}" for lam, row in per_lam.iterrows()))
+    for config in configs:
+        if not Path(config).exists():
+            continue
+        study = Study(yaml.safe_load(Path(config).read_text()), [config])
+        states = {name: (p.get("states", 0) * (1 + len(p.get("hold_loads", ()))), p.get("hold_interfaces", 1))
+                  for name, p in study.analyses.items() if name.startswith("thermal-events")}
+        sims = holds = longest = 0.0
+        for sim in study.simulations:
+            p = sim.params
+            lam, n, N = float(p.get("junction_strengthening", 0.0)), int(p["plates"]) - 1, int(p["N"])
+            base = per_lam.loc[per_lam.index[np.argmin(abs(per_lam.index - lam))]]
+            factor = (size ** (math.log(N / 162) / math.log(3))) * (1.0 if n == 1 else f3 * n / 3)
+            seconds = base.sim * factor * int(p["max_increments"])
+            state_s = base.state * factor * sum(k for k, m in states.values() if m in (0, n))
+            sims, holds, longest = sims + seconds, holds + state_s, max(longest, seconds + state_s)
+        print(f"- {config}: {len(study.simulations)} runs, {sims / 3600:.0f} CPU-h of runs + {holds / 3600:.0f} CPU-h of "
+              f"hold trials = {(sims + holds) / 3600:.0f} CPU-h; the longest run with its holds {longest / 3600:.1f} "
+              "CPU-h")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("studies", nargs="+", help="results directories (e.g. results/calibration)")
@@ -530,6 +602,8 @@ def main(argv=None):
     if not runs.empty:
         precheck_summary(runs, args.studies)
     cost_summary(args.studies, runs)
+    if not runs.empty:
+        planned_cost_summary(runs)
 
 
 if __name__ == "__main__":
