@@ -460,8 +460,10 @@ def cost_summary(studies, runs):
         rows = []
         for path in sorted(Path(study, "logs", "benchmarks", "sim").glob("*/*.tsv")):
             table = pd.read_csv(path, sep="\t")
-            rows.append((label.get(path.stem, path.parent.name), float(table["cpu_time"].iloc[-1]),
-                         float(table["s"].iloc[-1])))
+            start = _resumed_at(study, path.parent.name, path.stem)
+            rows.append((label.get(path.stem, path.parent.name) + (f", resumed at increment {start}: the CPU of "
+                                                                   "its last part" if start else ""),
+                         float(table["cpu_time"].iloc[-1]), float(table["s"].iloc[-1])))
         if not rows:
             continue
         print(f"- {study}: {len(rows)} simulations, {sum(r[1] for r in rows) / 60:.0f} CPU-min")
@@ -516,6 +518,16 @@ def _cpu(study, kind, run):
     return float(pd.read_csv(paths[0], sep="\t")["cpu_time"].iloc[-1]) if paths else math.nan
 
 
+def _resumed_at(study, solver, run):
+    """The increment a simulation's last job resumed at (0 if it ran whole), from its log."""
+    log = Path(study, "logs", "sim", solver, f"{run}.log")
+    text = log.read_text() if log.exists() else ""
+    if "resuming from" not in text:
+        return 0
+    match = re.search(r"fem increments: (\d+)/", text[text.rindex("resuming from"):])
+    return int(match.group(1)) if match else 0
+
+
 def per_increment(runs):
     """Per run: CPU seconds per increment of its simulation and per hold state of its thermal-events job."""
     rows = []
@@ -523,7 +535,8 @@ def per_increment(runs):
         params = r.data.attrs.get("params", {})
         holds = r.holds.attrs["analysis_params"].get("states", math.nan) if r.holds is not None else math.nan
         rows.append({"N": r.N, "n": r.n, "phi": r.phi, "thermal": bool(r.thermal), "lam": r.strengthening,
-                     "sim": _cpu(r.study, "sim", r.run) / int(params.get("max_increments", 1)),
+                     "sim": _cpu(r.study, "sim", r.run) / (int(params.get("max_increments", 1))
+                                                            - _resumed_at(r.study, "fem", r.run)),
                      "state": _cpu(r.study, "events/thermal-events", r.run) / holds})
     return pd.DataFrame(rows)
 
