@@ -579,8 +579,8 @@ def planned_cost_summary(runs, configs=PLANNED):
             seconds = base.sim * factor * int(p["max_increments"])
             state_s = base.state * factor * sum(k for k, m in states.values() if m in (0, n))
             sims, holds, longest = sims + seconds, holds + state_s, max(longest, seconds + state_s)
-        print(f"- {config}: {len(study.simulations)} runs, {sims / 3600:.0f} CPU-h of runs + {holds / 3600:.0f} CPU-h of "
-              f"hold trials = {(sims + holds) / 3600:.0f} CPU-h; the longest run with its holds {longest / 3600:.1f} "
+        print(f"- {config}: {len(study.simulations)} runs, {sims / 3600:.1f} CPU-h of runs + {holds / 3600:.1f} CPU-h "
+              f"of hold trials = {(sims + holds) / 3600:.1f} CPU-h; the longest run with its holds {longest / 3600:.1f} "
               "CPU-h")
 
 
