@@ -194,8 +194,14 @@ def seed_estimates(slips, clocks, by_n=False):
                 for fit in FITS:
                     result = estimate(single["T"], single["dmu"], t0=t0, fit=fit)
                     rows.append({"strengthening": lam, "seed": seed, "clock": clock, "eye": which, "fit": fit,
-                                 "mean_ln": float(np.nanmean(np.log(single["T"] / t0))), **result})
+                                 "mean_ln": _mean_log(single["T"] / t0), **result})
     return pd.DataFrame(rows)
+
+
+def _mean_log(values):
+    """The mean of ``ln values`` over the positive finite ones (a slip at T = 0 has no log)."""
+    values = np.asarray(values, dtype=float)
+    return float(np.mean(np.log(values[np.isfinite(values) & (values > 0)])))
 
 
 def estimator_summary(estimates, truth, title):
