@@ -602,12 +602,12 @@ def main(argv=None):
     truth = truth_table(runs[runs["thermal"].astype(bool)])
     if not calibration.empty:
         cal_truth = truth[truth["strength"] == 1.0]
-        slips, clocks = truth_summary(calibration, cal_truth)
+        alone, clocks = truth_summary(calibration, cal_truth)
         clock_summary(clocks)
-        alone = slips[slips["n"] == 1]
         estimator_summary(seed_estimates(alone, clocks), cal_truth, "n = 1 slips, per lambda and seed")
-        both = slips[slips["strengthening"].isin(slips.loc[slips["n"] == 2, "strengthening"].unique())]
-        both = both[both["seed"].isin(both.loc[both["n"] == 2, "seed"].unique())]
+        slips = run_slips(calibration)  # the n = 1 runs and the stacks
+        stacked = set(zip(slips.loc[slips["n"] == 2, "strengthening"], slips.loc[slips["n"] == 2, "seed"]))
+        both = slips[[key in stacked for key in zip(slips["strengthening"], slips["seed"])]]
         if both["n"].nunique() > 1:
             estimator_summary(seed_estimates(both, clocks), cal_truth,
                               "n = 1 and 2 pooled (the dissonance study's pool)")
