@@ -13,7 +13,7 @@ from ..formats import fem_run
 from ..plugin_params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
-from .thermal.junctions import expected_redraws
+from .trap_model import expected_redraws
 
 __all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "CYCLE_STRAIN", "REACH_MIN", "REACH_REGIME",
            "REACH_MELT", "CLOCK_ATTEMPTS", "REDRAWS_MAX", "thermal_reach", "stored_params"]
@@ -45,7 +45,7 @@ REACH_MELT = 1.0
 #: tells one attempt time from the next (2^52, its resolution): such an attempt rate is refused.
 CLOCK_ATTEMPTS = 2.0 ** 52
 #: Redraws of one junction in a stick-slip cycle (or hold) that the trap model expects
-#: (:func:`.thermal.junctions.expected_redraws`) beyond which a run would not end (hours per cycle): refused.
+#: (:func:`.trap_model.expected_redraws`) beyond which a run would not end (hours per cycle): refused.
 REDRAWS_MAX = 1e6
 
 

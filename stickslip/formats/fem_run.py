@@ -31,7 +31,7 @@ equal runs give equal bytes):
     Scaled linear response: ``delta_u`` [ndof], ``delta_eps`` [ni, 4, 3],
     ``delta_target`` [nlayer], ``delta_lever`` [1].
 ``/state``
-    One row per increment, enough to restore it: ``u`` [ninc, ndof], ``target``
+    One row per increment, enough to restore it (:class:`StoredState`): ``u`` [ninc, ndof], ``target``
     [ninc, nlayer], ``lever_target`` [ninc], ``t`` [ninc]; and any further state the producer
     declares (``create_file``'s ``state_fields``, e.g. ``fem`` with junction aging:
     ``junction_depth``, ``junction_well`` [ninc, ni]), which files without it lack.
@@ -49,6 +49,8 @@ consumers read them from here and never recompute them.
 
 import json
 import numbers
+from types import MappingProxyType
+from typing import Mapping, NamedTuple
 
 import h5py
 import numpy as np
@@ -60,7 +62,7 @@ from ..h5io import (FileFormatError, attribute, copy_file, open_file, read_array
 from ..mesh import load_mesh, save_mesh
 from ..output_safety.atomic import atomic_output
 
-__all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
+__all__ = ["FORMAT", "HEADER", "REGIMES", "StoredState", "create_file", "append_increment", "rewrite", "read_params",
            "read_increments", "read_run_attrs", "stored_increments", "RunFile", "describe", "check_arithmetic"]
 
 #: The format name of these files (:mod:`stickslip.formats`).
@@ -92,6 +94,33 @@ HEADER = {
 
 _KINDS = {"int": (numbers.Integral,), "float": (numbers.Real,), "str": (str,), "json": (dict,)}
 
+
+
+class StoredState(NamedTuple):
+    """One stored increment's state: what restores it (``/state``), the record that writers, readers and producers share.
+
+    Attributes
+    ----------
+    u : numpy.ndarray
+        float64 [ndof] displacement [length].
+    target : numpy.ndarray
+        float64 [nlayer] drive targets of the layers [length].
+    lever_target : float
+        The free lever's drive target [length] (0 for a fixed lever).
+    t : float
+        Time [time].
+    further : Mapping[str, numpy.ndarray]
+        The producer's further state (``create_file``'s ``state_fields``) by dataset name; empty without it.
+    """
+
+    u: object
+    target: object
+    lever_target: float
+    t: float
+    further: Mapping = MappingProxyType({})
+
+
+#: The datasets of every file's stored state, by :class:`StoredState` field.
 _STATE = ("u", "target", "lever_target", "t")
 
 
@@ -127,7 +156,7 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
         Types of columns that are neither float64 nor the well counts ``S_*``, ``A_*`` (int64).
     state_fields : Mapping[str, tuple], optional
         Further state stored per increment: name -> ``(shape, dtype)`` of one increment's value
-        (datasets ``/state/<name>``; :func:`append_increment` takes their values as a fifth item).
+        (datasets ``/state/<name>``; :func:`append_increment` takes their values as :attr:`StoredState.further`).
     arithmetic : Mapping[str, object], optional
         What decides the bits beside :func:`stickslip.arithmetic.decisive` (a device backend's GPU,
         :func:`stickslip.fem.backends.backend_arithmetic`), recorded with it in ``arithmetic``.
@@ -183,15 +212,14 @@ def append_increment(file, state, row):
     Parameters
     ----------
     file : h5py.File
-    state : tuple
-        ``(u [ndof], target [nlayer], lever_target, t)``: what restores the increment; with further
-        state (``create_file``'s ``state_fields``) a fifth item, a mapping of their values.
+    state : StoredState
+        What restores the increment (its ``further`` the values of ``create_file``'s ``state_fields``).
     row : dict
         ``increment``, ``kick``, ``yield_element`` and the observables.
     """
-    for name, value in zip(_STATE, state):
-        _append(file["state"][name], value)
-    for name, value in (state[4] if len(state) > 4 else {}).items():
+    for name in _STATE:
+        _append(file["state"][name], getattr(state, name))
+    for name, value in state.further.items():
         _append(file["state"][name], value)
     table = file["increments"]
     for name in json.loads(table.attrs["columns"]):
@@ -340,13 +368,13 @@ class RunFile:
         self.nstored = stored_increments(file)
 
     def state(self, increment):
-        """(u, target, lever_target, t) of a stored increment; a file with further state adds a mapping of it."""
+        """The :class:`StoredState` of a stored increment (its ``further`` empty in a file without further state)."""
         if not 0 <= increment < self.nstored:
             raise FileFormatError(f"{self.file.filename}: increment {increment} is not stored "
                                   f"(0 ... {self.nstored - 1})")
         u, target, lever_target, t = (read_array(self.file["state"][name], increment) for name in _STATE)
         further = {name: read_array(self.file["state"][name], increment) for name in self._further()}
-        return (u, target, float(lever_target), float(t)) + ((further,) if further else ())
+        return StoredState(u, target, float(lever_target), float(t), further)
 
     def _further(self):
         return [name for name in sorted(self.file["state"]) if name not in _STATE]
