@@ -45,7 +45,7 @@ def main(argv=None):
         for _ in range(args.repeat):
             for per_call in times:
                 minimise.STEPS_PER_CALL = per_call
-                simulation.stack.restore(*start)
+                simulation.stack.restore(start)
                 begin = time.process_time()
                 for increment in range(1, args.increments + 1):
                     simulation.protocol.step(increment % 2 == 0, params.margin, increment)

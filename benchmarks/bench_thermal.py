@@ -54,7 +54,7 @@ def draw_cost(path, draws):
     replay = EventReplay(path)
     sim = replay.simulation
     with open_file(path) as file:
-        sim.stack.restore(*RunFile(file).state(replay.nstored - 1))
+        sim.stack.restore(RunFile(file).state(replay.nstored - 1))
     p, model = sim.params, sim.model
     idx, eps = sim.backend.read("idx", "eps")
     beta = 1.0 / (p.temperature * energy_unit(p, sim.constants["h"]))

@@ -65,7 +65,7 @@ def replays(path, scales, max_events):
         sim = Simulation(dataclasses.replace(params, dt_scale=float(scale)), mesh, make_backend(params.backend),
                          response=response)
         for increment, (before, after) in states.items():
-            sim.stack.restore(*before)
+            sim.stack.restore(before)
             kick = KickAlongResponse(sim.loading, bool(yield_element[increment]))
             _, events = sim.protocol.perturb_and_relax(kick, params.margin, record=True)
             reproduced = bool(np.array_equal(sim.backend.read("u")[0], after[0]))

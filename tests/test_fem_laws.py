@@ -148,4 +148,4 @@ def test_the_event_driven_protocol_and_both_relaxations_run_with_the_smooth_law(
         assert v.max() == v.min() == 0.0
         scale = np.abs(u).max()
         assert np.abs(dynamic.backend.read("u")[0] - u).max() < 1e-3 * scale
-        dynamic.stack.restore(*exact.stack.stored())  # continue both from the same state
+        dynamic.stack.restore(exact.stack.stored())  # continue both from the same state

@@ -56,7 +56,7 @@ def _fem_header(N, plates):
 
 def write_fem_run(path, N=9, plates=2, increments=41):
     """A small valid ``fem-run`` file (synthetic numbers: a sawtooth of load and slips, every 8th event a slip)."""
-    from stickslip.formats.fem_run import append_increment, create_file
+    from stickslip.formats.fem_run import StoredState, append_increment, create_file
     from stickslip.h5io import open_file
 
     mesh, header = _fem_header(N, plates)
@@ -76,7 +76,7 @@ def write_fem_run(path, N=9, plates=2, increments=41):
             row = {"increment": i, "kick": kick, "yield_element": False, "t": float(i), "gamma": 0.1 * i,
                    "epsd": 0.1 * i, "sigd": stress, **{name: rng.random() for name in layers},
                    **{name: (N if slip else int(kick)) for name in interfaces}}
-            append_increment(file, (rng.random(ndof), np.arange(nlayer, dtype=float), 0.0, float(i)), row)
+            append_increment(file, StoredState(rng.random(ndof), np.arange(nlayer, dtype=float), 0.0, float(i)), row)
     return path
 
 

@@ -29,7 +29,7 @@ def make_protocol(simulation, table=None):
     s = simulation
     if s.params.temperature > 0.0:
         return thermal_protocol(s.stack, s.model, s.loading, s.relaxation, s.params, s.mesh, s.constants, table)
-    return AthermalProtocol(s.stack, s.loading, s.relaxation)
+    return AthermalProtocol(s.stack, s.loading, s.relaxation, table)
 
 
 class Simulation:
