@@ -6,7 +6,8 @@ thread, a time step of an N = 9 stack in ~0.1-0.3 s: the checks are short sequen
 ``structured`` CPU backend from the same state (states within round-off, wells and statuses equal):
 the force evaluation (fixed and free lever), time steps after a kick, a minimisation stopped by each of
 its criteria (step limit, quiet window, residual, margin) with the recorded well changes, the exact
-relaxation's direct solve, a thermal increment, and a batch of three realisations whose every member
+relaxation's direct solve, a thermal increment, a checkpoint (the changes of well since it counted on the device,
+the rollback across a change of the held yield strains), and a batch of three realisations whose every member
 equals the same realisation run alone, bit for bit. The simulator checks no types: every kernel is also
 compiled to PTX for sm_90 (the H100) with numba-cuda's NVVM. Skipped without numba-cuda (failed instead
 where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set, as .ci/run does); the checks that need a real GPU are in
@@ -43,6 +44,7 @@ PRELUDE = """
     from stickslip.mesh import MeshParams, build_stack_mesh
 
     FIELDS = ("u", "v", "a", "f", "eps", "sig", "ubar", "target", "lever", "t")
+    CHECKED = ("u", "v", "a", "f", "idx", "eps", "sig", "ubar", "target", "lever", "t")
 
     def pair(**values):
         values = {"N": 9, "plates": 2, "seed": 1, "k_drive": 1e-3, "dt_scale": 4.0, **values}
@@ -144,13 +146,30 @@ def simulated(numba_cuda):
     for sim in (cpu, gpu):
         sim.loading.step(False)
         sim.loading.step(True)
-    ny = cpu.model.epsy.shape[1]
+    ny = cpu.stack.yield_strains.shape[1]
     out["margin"] = [sim.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
     # a thermal load increment (kinetic Monte Carlo on the host, the hop's relaxation on the device)
     cpu, gpu = pair(relaxation="exact", quiet_steps=3, temperature=2e-3, drive_rate=1e-5)
-    out["thermal"] = [[sim.protocol.step(False, 5, 1)] for sim in (cpu, gpu)]
+    out["thermal"] = [[sim.protocol.step(5, 1)] for sim in (cpu, gpu)]
     out["thermal_state"] = compare(cpu, gpu)
     out["thermal_wells"] = bool(np.array_equal(cpu.stack.well_index(), gpu.stack.well_index()))
+    # a checkpoint on the device: the changes of well since it counted there, and the rollback across a change of
+    # the held yield strains (the windows widened since)
+    cpu, gpu = pair()
+    out["checkpoint"] = []
+    for sim in (cpu, gpu):
+        stack = sim.stack
+        sim.loading.step(False)
+        token, ny, wells = stack.checkpoint(), stack.yield_strains.shape[1], stack.well_index()
+        kept = [array.tobytes().hex() for array in sim.backend.read(*CHECKED)]
+        sim.loading.step(True)
+        stack.widen_wells()
+        changed = [stack.changed_since(token), stack.changed_since(token, elements=np.arange(3)),
+                   int(np.count_nonzero(stack.well_index() != wells)),
+                   int(np.count_nonzero(stack.well_index()[:3] != wells[:3]))]
+        stack.rollback(token)
+        back = [array.tobytes().hex() for array in sim.backend.read(*CHECKED)]  # the backend's, not the stack's copies
+        out["checkpoint"].append(changed + [stack.changed_since(token), back == kept, stack.yield_strains.shape[1] == ny])
     # a batch of three realisations whose minimisations end at different launches, against each alone
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
     steps = {1: 3, 2: 5, 3: 2}
@@ -198,6 +217,14 @@ def test_a_thermal_increment_draws_the_same_event_on_the_device(simulated):
     differences = dict(simulated["thermal_state"])
     assert differences.pop("idx")
     assert all(value < 1e-9 for value in differences.values()), differences  # exact solves: tol^2 residuals
+
+
+def test_a_checkpoint_on_the_device_counts_the_changes_of_well_and_rolls_back_bit_for_bit(simulated):
+    cpu, gpu = simulated["checkpoint"]
+    assert cpu == gpu
+    changed, in_three, wells, wells_in_three, after, equal, width = gpu
+    assert changed == wells > 0 and in_three == wells_in_three
+    assert after == 0 and equal and width  # the yield strains held at the checkpoint held again
 
 
 def test_a_batch_member_equals_the_same_realisation_run_alone_bit_for_bit(simulated):
@@ -334,7 +361,7 @@ def test_an_ensemble_computes_a_linear_response_in_a_batch_of_the_elastic_law(nu
     params = FemParams(N=9, plates=2, nchunk=30)
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
     model, _ = stack_model(params, mesh, derived_constants(params, mesh))
-    elastic = model._replace(law=Elastic(*model.law), epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
+    elastic = model._replace(law=Elastic(*model.law))
     ensemble = Ensemble(1)
     cusp_batch, elastic_batch = ensemble.batch_for(model, mesh), ensemble.batch_for(elastic, mesh)
     try:
