@@ -99,7 +99,7 @@ def test_uniaxial_strain_gives_bulk_and_shear_energy(sim):
 def _undamped_energy_error(sim, dt, nsteps):
     model = sim.model._replace(damping=np.zeros(sim.model.ndof), dt=dt,
                                      drive_active=np.zeros_like(sim.model.drive_active))
-    backend = sim.backend.for_model(model)
+    backend = sim.backend.for_model(model, sim.stack.yield_strains)
     x, y = sim.mesh.coor[:, 0], sim.mesh.coor[:, 1]
     L, H = sim.mesh.N * sim.mesh.h, y.max()
     u = np.zeros(model.ndof)
@@ -145,7 +145,7 @@ def test_shear_pulse_travels_at_the_shear_wave_speed():
     mesh = _column_mesh(nx, ny, h)
     model = build_model(mesh, law=Cusp(4.5, 1.0), rho=1.0, alpha=0.0, dt=0.05, k_drive=0.0,
                         drive_active=np.array([False]), free_lever=False, lever_height=1.0)
-    backend = make_backend().prepare(model, mesh)
+    backend = make_backend().prepare(model, mesh, np.zeros((0, 2)))  # no interface
     c_s = math.sqrt(1.0 / 2.0 / 1.0)
     y = mesh.coor[:, 1]
     y0, width = 100 * h, 12 * h
@@ -210,7 +210,7 @@ def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells
     # recompute path)
     backend = Simulation(FemParams(N=9, plates=3, nchunk=50, interface_law=law),
                          build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).backend
-    model, state = backend.model, new_state(backend.model)._replace(epsy=backend.state.epsy)
+    model, state = backend.model, new_state(backend.model, backend.state.epsy)
     assert model.law.name == law
     rng = np.random.default_rng(3)
     state.u[:] = 2e-3 * rng.standard_normal(model.ndof)

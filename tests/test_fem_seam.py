@@ -164,6 +164,7 @@ def test_the_backend_owns_the_state_transfers_per_event_do_not_grow_with_the_tim
 #: fourth load increment is a backward hop instead (these fall back), and the draw after it must find the stack as the
 #: hop found it, bit for bit.
 HOPS = """
+    from counting_backend import TRANSFERS
     from stickslip.fem.thermal.barriers import BACKWARD
     from stickslip.fem.thermal.sampler import HOP
     from stickslip.fem.thermal.sources import Draw
@@ -207,13 +208,13 @@ HOPS = """
             row = protocol.step(5, increment)
             if not row["kick"]:
                 attempts = row["failed_hops"] + int(row["hop_block"] >= 0)
-                loads.append((attempts, {name: transfers[name] - before.get(name, 0) for name in transfers}))
+                loads.append((attempts, {name: transfers[name] - before.get(name, 0) for name in TRANSFERS}))
         hops = []
         for i, (name, _) in enumerate(marks):
             if name == "hop":
                 start = next(counts for mark, counts in reversed(marks[:i]) if mark == "draw")
                 end = next(counts for mark, counts in marks[i + 1:] if mark in ("draw", "end"))
-                hops.append({key: end[key] - start.get(key, 0) for key in end})
+                hops.append({key: end.get(key, 0) - start.get(key, 0) for key in TRANSFERS})
         return {"hops": hops, "loads": loads, "back": back}
 
     print(json.dumps({"dynamic": hops_and_loads(relaxation="dynamic"), "exact": hops_and_loads(relaxation="exact"),

@@ -236,10 +236,10 @@ def _speed(out, plates):
     model, state = sim.model, sim.stack.stored()
     for count, groups in [(1, g) for g in SIZES["alone_groups"]] + [(b, None) for b in SIZES["batches"]]:
         batch = DeviceBatch(sim.backend.batch.mesh, model.law, count, groups)
-        members = [CudaBackend().bound(model, mesh, batch) for _ in range(count)]
+        members = [CudaBackend().bound(model, mesh, batch, sim.stack.yield_strains) for _ in range(count)]
         for member in members:
             member.set_load_direction(response.delta_u, response.delta_target, response.delta_lever)
-            member.set_state(*state)
+            member.set_state(state.u, state.target, state.lever_target, state.t)
             batch.begin(member.slot, (0.0, 1, 10 ** 12, 0, False, 0))
         slots = [member.slot for member in members]
         batch.launcher.minimise(slots, batch.state, SIZES["launch"])  # compiles on the first launch

@@ -187,9 +187,9 @@ class Stack:
             self.hold_wells_ahead()
         return niter, events
 
-    def backend_for(self, model):
+    def backend_for(self, model, epsy):
         """A backend for another model on the stack's mesh, its own state (:meth:`.backends.base.Backend.for_model`)."""
-        return self._backend.for_model(model)
+        return self._backend.for_model(model, epsy)
 
     def push_yield_strains(self):
         """Give the backend the yield strains it holds anew (a modifier's state changed: :meth:`.window.HeldWindow.push`)."""

@@ -53,8 +53,8 @@ def read_only(array):
 
 
 def unbounded_wells(ni):
-    """Yield strains of one unbounded well per Gauss point, ``[-inf, inf]`` (the interfaces elastic): float64 [ni, 2],
-    what a backend holds until it is given others (:meth:`Backend.prepare`)."""
+    """Yield strains of one unbounded well per Gauss point, ``[-inf, inf]``: float64 [ni, 2], for a model whose
+    interfaces are elastic (:class:`..laws.Elastic`; the linear response's)."""
     return np.tile(np.array([[-np.inf, np.inf]]), (ni, 1))
 
 
@@ -75,28 +75,20 @@ class Backend(abc.ABC):
         return ""
 
     @abc.abstractmethod
-    def prepare(self, model, mesh):
+    def prepare(self, model, mesh, epsy):
         """A backend for ``model`` on ``mesh`` (a new object) owning a state at rest at the origin.
 
-        Parameters
-        ----------
-        model : stickslip.fem.model.Model
-        mesh : stickslip.mesh.LayeredMesh
-            The mesh the model was built from.
-
-        Returns
-        -------
-        Backend
-            ``u = v = a = 0``, drive targets 0, ``t = 0``, forces evaluated; the yield strains one unbounded well
-            per Gauss point (:func:`unbounded_wells`: the interfaces elastic) until :meth:`set_yield_strains`.
+        ``model`` (:class:`..model.Model`) built from ``mesh`` (:class:`...mesh.LayeredMesh`); ``epsy`` the yield
+        strains it holds (as :meth:`set_yield_strains`'s; :func:`unbounded_wells` for elastic interfaces). The state:
+        ``u = v = a = 0``, drive targets 0, ``t = 0``, every Gauss point in the well of its strain, forces evaluated.
         """
 
     @abc.abstractmethod
-    def for_model(self, model):
-        """A prepared backend for another model on the same mesh and drive (e.g. another law).
+    def for_model(self, model, epsy):
+        """A prepared backend for another model on the same mesh and drive (e.g. another law), holding ``epsy``.
 
-        It shares what depends on the mesh only and owns a state of its own, at rest at the origin with unbounded
-        wells (as :meth:`prepare`'s).
+        It shares what depends on the mesh only and owns a state of its own, at rest at the origin (as
+        :meth:`prepare`'s).
         """
 
     @abc.abstractmethod
@@ -148,11 +140,9 @@ class Backend(abc.ABC):
     def set_yield_strains(self, epsy, shift=None):
         """Replace the held yield strains by ``epsy`` [ni, ny]; lower every well index of block ``e`` by ``shift[e]``.
 
-        ``epsy`` is the backend's from now on: the caller gives a new array for other values, never changes it.
-
         The window of held yield strains moved (the same wells, numbered from another start) or was
         widened, or restarted (``shift`` None); forces re-evaluated, every Gauss point moved to
-        the well of its strain.
+        the well of its strain. ``epsy`` is the backend's from now on: the caller never changes it.
         """
 
     @abc.abstractmethod
@@ -166,9 +156,8 @@ class Backend(abc.ABC):
 
     @abc.abstractmethod
     def wells_changed(self, token, shift=None, elements=None):
-        """How many interface Gauss points are in another well than at :meth:`checkpoint` ``token``.
-
-        Counted where the state is (one number comes to the host).
+        """How many interface Gauss points are in another well than at :meth:`checkpoint` ``token`` (counted where the
+        state is: one number comes to the host).
 
         Parameters
         ----------

@@ -76,7 +76,7 @@ class CpuBackend(Backend):
         """The plate operator of a model on its mesh (a registered named tuple, :mod:`.plates`)."""
         raise NotImplementedError
 
-    def prepare(self, model, mesh):
+    def prepare(self, model, mesh, epsy):
         nblock = parallel_blocks(self.threads)
         grad, volume = interface_layout(model.iface_dNdx, model.iface_dV)
         ni = model.iface_dofs.shape[0]
@@ -84,12 +84,12 @@ class CpuBackend(Backend):
                               fe=np.zeros((ni, 8)))
         prepared = copy.copy(self)
         prepared.work = CpuWork(nblock=nblock, plates=self.plate_operator(model, mesh, nblock), iface=iface)
-        return prepared.for_model(model)
+        return prepared.for_model(model, epsy)
 
-    def for_model(self, model):
+    def for_model(self, model, epsy):
         other = copy.copy(self)
         other.model = model
-        other.state = new_state(model)
+        other.state = new_state(model, np.ascontiguousarray(epsy, dtype=np.float64))
         other._direction = None
         other._evaluate(True)
         return other

@@ -4,8 +4,6 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..base import unbounded_wells
-
 __all__ = ["State", "new_state"]
 
 State = namedtuple("State", [
@@ -21,13 +19,15 @@ State = namedtuple("State", [
 ])
 
 
-def new_state(model):
-    """A state at rest: zero displacement, velocity, targets and time, one unbounded well per Gauss point (forces not yet
-    evaluated).
+def new_state(model, epsy):
+    """A state at rest holding the yield strains ``epsy`` [ni, ny]: zero displacement, velocity, targets and time
+    (forces not yet evaluated).
 
     Parameters
     ----------
     model : stickslip.fem.model.Model
+    epsy : numpy.ndarray
+        float64 [ni, ny], kept (not copied).
 
     Returns
     -------
@@ -37,6 +37,5 @@ def new_state(model):
     nlayer = model.layer_volume.size
     return State(u=np.zeros(model.ndof), v=np.zeros(model.ndof), a=np.zeros(model.ndof), f=np.zeros(model.ndof),
                  idx=np.zeros((ni, 4), dtype=np.int64), eps=np.zeros((ni, 4, 3)), sig=np.zeros((ni, 4, 3)),
-                 target=np.zeros(nlayer), ubar=np.zeros(nlayer), lever=np.zeros(2), t=np.zeros(1),
-                 epsy=unbounded_wells(ni))
+                 target=np.zeros(nlayer), ubar=np.zeros(nlayer), lever=np.zeros(2), t=np.zeros(1), epsy=epsy)
 

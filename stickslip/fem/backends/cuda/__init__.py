@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..base import Backend, unbounded_wells
+from ..base import Backend
 
 __all__ = ["CudaBackend", "run_ensemble"]
 
@@ -86,29 +86,30 @@ class CudaBackend(Backend):
     def unavailable(cls):
         return _why_not()
 
-    def prepare(self, model, mesh):
+    def prepare(self, model, mesh, epsy):
         from .batch import DeviceBatch  # numba-cuda is optional: imported when a run asks for it
         from .device import DeviceMesh
 
         if self.member is not None:
-            return self.bound(model, mesh, self.member.ensemble.batch_for(model, mesh))
+            return self.bound(model, mesh, self.member.ensemble.batch_for(model, mesh), epsy)
         return self.bound(model, mesh, DeviceBatch(self.device_mesh or DeviceMesh(model, mesh), model.law, 1,
-                                                   self.groups))
+                                                   self.groups), epsy)
 
-    def for_model(self, model):
+    def for_model(self, model, epsy):
         from .batch import DeviceBatch
 
         if self.member is not None:
-            return self.bound(model, self.mesh, self.member.ensemble.batch_for(model, self.mesh))
-        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups))
+            return self.bound(model, self.mesh, self.member.ensemble.batch_for(model, self.mesh), epsy)
+        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups), epsy)
 
-    def bound(self, model, mesh, batch):
-        """A backend for ``model`` on ``mesh`` in a free slot of ``batch``, at rest at the origin."""
+    def bound(self, model, mesh, batch, epsy):
+        """A backend for ``model`` on ``mesh`` holding the yield strains ``epsy`` [ni, ny] in a free slot of ``batch``,
+        at rest at the origin."""
         bound = CudaBackend(self.threads, self.member, self.groups)
         bound.model, bound.mesh, bound.batch, bound.device_mesh = model, mesh, batch, batch.mesh
         bound.slot = batch.attach(model, bound)
-        bound._epsy = unbounded_wells(model.iface_dofs.shape[0])
-        batch.set_yield_strains(bound.slot, bound._epsy, None)
+        bound._epsy = epsy
+        batch.set_yield_strains(bound.slot, epsy, None)
         bound.set_state(np.zeros(model.ndof), np.zeros(model.layer_volume.size), 0.0, 0.0)
         return bound
 
