@@ -4,7 +4,7 @@ The backend that owns the state is private to :class:`stickslip.fem.stack.Stack`
 :class:`stickslip.fem.simulation.Simulation` that composes a run, for backend-level tests and benchmarks); the model's
 static parts are passed to those who need them; the yield strains the backend holds now are the stack's
 (:attr:`~stickslip.fem.stack.Stack.yield_strains`); junction aging is a yield-strain modifier that its protocol
-registers, so the stack imports nothing of the protocols.
+registers, so the stack imports nothing of the protocols (and the parameters nothing of the thermal package).
 """
 
 import ast
@@ -41,11 +41,17 @@ def test_no_module_of_the_package_reaches_past_the_stack():
     assert not found, "\n".join(found)
 
 
-def test_the_stack_imports_nothing_of_the_protocols():
-    tree = ast.parse((PACKAGE / "fem" / "stack.py").read_text())
+def _imports(name):
+    tree = ast.parse((PACKAGE / "fem" / name).read_text())
     imported = [node.module or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)]
-    imported += [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names]
+    return imported + [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names]
+
+
+def test_the_stack_imports_nothing_of_the_protocols_nor_the_parameters_of_the_thermal_package():
+    imported = _imports("stack.py")
     assert not [m for m in imported if "thermal" in m or "protocol" in m], imported
+    imported = _imports("parameters.py")
+    assert imported and not [m for m in imported if "thermal" in m], imported
 
 
 def test_the_grep_finds_a_reach_through():
