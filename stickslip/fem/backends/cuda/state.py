@@ -10,6 +10,7 @@ checkpoint is counted on the device (:meth:`DeviceState.wells_changed`, one inte
 import numpy as np
 from numba import cuda
 
+from .launch import launching
 from .minimise import ROWS
 from .records import CHECKPOINT_FIELDS, STATE_FIELDS, Control, State
 
@@ -126,8 +127,9 @@ class DeviceState:
         count = self._changed[slot:slot + 1]
         count.copy_to_device(np.zeros(1, dtype=np.int64))
         points = 4 * elements.size
-        count_changed[max(1, -(-points // COUNT_THREADS)), COUNT_THREADS](self.arrays["idx"][slot], token["idx"][0],
-                                                                           shift, elements, count)
+        with launching():  # as every launch (the simulator's are not safe from two threads at once)
+            count_changed[max(1, -(-points // COUNT_THREADS)), COUNT_THREADS](self.arrays["idx"][slot],
+                                                                               token["idx"][0], shift, elements, count)
         return int(count.copy_to_host()[0])
 
     def hold_yield_strains(self, slot, epsy):
