@@ -100,6 +100,20 @@ def test_every_kernel_compiles_for_sm_90_with_one_grid_barrier_per_step_and_no_f
         assert figures["grid_barriers"] == (1 if name.endswith(":minimise") else 0), name
 
 
+def test_the_count_of_changed_wells_compiles_for_sm_90_with_integer_atomics_only(numba_cuda):
+    result = _run("""
+    import numba
+    from numba import cuda
+    from stickslip.fem.backends.cuda.changed_wells import count_changed
+    from stickslip.fem.backends.cuda.compile import ptx_figures
+    wells, rows = np.zeros((9, 4), np.int64), np.zeros(9, np.int64)
+    signature = tuple(numba.typeof(array) for array in (wells, wells, rows, rows, np.zeros(1, np.int64)))
+    text, _ = cuda.compile(count_changed.py_func, signature, device=False, cc=(9, 0), abi="numba", output="ptx")
+    print(json.dumps({**ptx_figures(text), "integer_atomics": text.count("atom.global.add.u64")}))
+    """, simulator=False)
+    assert result["target"] == "sm_90" and result["float_atomics"] == [] and result["integer_atomics"] == 1
+
+
 @pytest.fixture(scope="module")
 def simulated(numba_cuda):
     """Every check on the simulator, in one fresh Python (module docstring); results by check."""

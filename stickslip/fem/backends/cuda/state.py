@@ -4,36 +4,19 @@ A :class:`DeviceState` holds the :class:`.records.State` and :class:`.records.Co
 realisations of one mesh (``[size, ...]`` arrays; realisation ``slot`` is row ``slot``) and builds the
 records the kernels take. Arrays that grow (the held yield strains, the event buffers) are replaced by
 larger ones, their content kept, so a record is built for each launch. Whether a Gauss point changed well since a
-checkpoint is counted on the device (:meth:`DeviceState.wells_changed`, one integer to the host).
+checkpoint is counted on the device (:meth:`DeviceState.wells_changed`, :mod:`.changed_wells`; one integer to the
+host).
 """
 
 import numpy as np
 from numba import cuda
 
+from .changed_wells import COUNT_THREADS, count_changed
 from .launch import launching
 from .minimise import ROWS
 from .records import CHECKPOINT_FIELDS, STATE_FIELDS, Control, State
 
-__all__ = ["DeviceState", "count_changed"]
-
-#: Threads per block of :func:`count_changed`.
-COUNT_THREADS = 128
-
-
-@cuda.jit
-def count_changed(now, then, shift, elements, count):
-    """``count[0]`` += the Gauss points of ``elements`` whose well ``now[e, q] + shift[e]`` is not ``then[e, q]``.
-
-    ``now``, ``then`` int64 [ni, 4] wells; ``shift`` int64 [ni]; ``elements`` int64 [k]; one thread per Gauss point
-    (integer atomics: the count does not depend on the order).
-    """
-    i = cuda.grid(1)
-    if i < elements.size * 4:
-        e = elements[i // 4]
-        q = i % 4
-        if now[e, q] + shift[e] != then[e, q]:
-            cuda.atomic.add(count, 0, 1)
-
+__all__ = ["DeviceState"]
 
 class DeviceState:
     """The state and minimisation control of ``size`` realisations of ``mesh`` on the device.
