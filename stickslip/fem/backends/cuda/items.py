@@ -67,13 +67,14 @@ def build(jit, law_class):
                 fy += gy
         return fx, fy
 
-    def interface_element(law, e, u, dofs, dNdx, dV, epsy, ny, idx, eps, sig, fe, owner, update_wells, ue, strain):
+    def interface_element(law, e, u, dofs, dNdx, dV, epsy, ny, idx, eps, sig, fe, owner, update_wells, store, ue,
+                          strain):
         """Strain, well, stress and element force of interface element ``e`` (:mod:`..cpu.interface_elements`).
 
         ``epsy`` [ni, >= ny] the held yield strains; ``fe`` [8] receives the element force; the element's
-        strain, stress and well are written if ``owner`` (another tile may compute the same element: the well
-        search does not depend on where it starts, so both find the same wells). ``ue`` [8], ``strain`` [4, 3]
-        scratch. Returns ``(moved, top)``: 1 if a Gauss point changed well, and the largest well of the element.
+        well is written if ``owner``, its strain and stress if ``owner`` and ``store`` (another tile may compute
+        the same element: the well search does not depend on where it starts, so both find the same wells).
+        ``ue`` [8], ``strain`` [4, 3] scratch. Returns ``(moved, top)``: 1 if a Gauss point changed well, and the largest well of the element.
         """
         for a in range(8):
             ue[a] = u[dofs[e, a]]
@@ -97,7 +98,7 @@ def build(jit, law_class):
             strain[q, 0] = law.K * m + g * (xx - m)  # the strain's row now holds the stress
             strain[q, 1] = law.K * m + g * (yy - m)
             strain[q, 2] = g * xy
-            if owner:
+            if owner and store:
                 eps[e, q, 0] = xx
                 eps[e, q, 1] = yy
                 eps[e, q, 2] = xy
