@@ -121,6 +121,11 @@ class Launcher:
             self._capacity = int(compiled.max_cooperative_grid_blocks(self.block))
         return self._capacity
 
+    @property
+    def capacity(self):
+        """Blocks of the minimisation kernel the device holds at once (None before the first launch)."""
+        return self._capacity
+
     def groups_for(self, count, arguments):
         """Blocks per realisation for a launch of ``count`` realisations: all co-resident if more than one (the
         resident kernel: every tile's block)."""

@@ -6,10 +6,12 @@ tiles, the verdict, the end of a launch), arranged for the time between two barr
 - a realisation is spread over exactly its ``ntile`` blocks, block ``part`` computes tile ``part`` in every step
   of the launch (:class:`.launch.Launcher` launches as many realisations at once as the device holds blocks
   together, and the others in the next launch of the same round);
-- what a node's thread needs every step is read once per launch: the tile's stencil triplets into shared
-  memory, and into registers its velocities, accelerations, displacement, forces and per-DOF constants
-  (inverse mass, damping, free, multiplicity) and its stencil row (``slots`` nodes per thread: 1 on a GPU,
-  where a block has at least ``tile`` threads; more on numba's simulator, whose blocks are 8 threads);
+- what a node's thread needs every step is read once per launch: into shared memory the tile's stencil triplets
+  and its nodes' per-DOF constants (inverse mass, damping, multiplicity, free), displacements, velocities and
+  accelerations, where their forces are kept too; into registers its node and stencil row (``SLOTS`` nodes per
+  thread: 1 on a GPU, where a block has at least ``tile`` threads; more on numba's simulator, whose blocks are 8
+  threads). Held in registers instead, the constants and the motion made the kernel spill under its register cap
+  (216 bytes of stack with the displacement, velocity and acceleration alone: ``compile.ptx_figures``);
 - a step reads what other blocks wrote (displacements, the tiles' sums) before it writes (the next
   displacement, its own sums); the velocities, accelerations, forces, strains and stresses reach device memory
   at the end of the launch only (the strains and stresses by the tile's elements computed once more from the
@@ -24,18 +26,22 @@ realisation gives the bytes of that kernel (tests/test_fem_cuda.py); the verdict
 last bit from the power's, which moves a decision only if the residual equals ``tol`` to that bit.
 """
 
-from numba import config, cuda, float64, int8, int32, int64
+from numba import config, cuda, float64, int32, int64
 
 from .layout import LEAVES, MAX_LAYERS, MAX_TILE, MAX_TILE_ELEMENTS, MAX_TILE_TRIPLETS
 from .minimise import EVENTS_FULL, ROWS, RUNNING
 from .sync import BARRIER_TIMEOUT
 from .tiles import LAYER_ROW
 
-__all__ = ["build", "SLOTS", "block_threads"]
+__all__ = ["build", "SLOTS", "HELD", "block_threads"]
 
 #: Nodes of a tile one thread of the resident kernel holds: one on a GPU (a block holds at least a tile); on numba's
 #: simulator, whose blocks are 8 threads (:func:`.launch.threads_per_block`), a tile's worth.
 SLOTS = MAX_TILE // 8 if config.ENABLE_CUDASIM else 1
+
+#: What a block holds of each DOF of its tile (shared ``held`` [slot, DOF, HELD]): its constants, then its motion.
+INVERSE_MASS, DAMPING, MULTIPLICITY, FREE, U, V, A, F = range(8)
+HELD = 8
 
 
 def block_threads(tile, elements):
@@ -53,10 +59,11 @@ def build(device, items, sync, tiles, step):
     drive, sums, judge, finish = step.drive, step.sums, step.judge_sqrt, step.finish
 
     @device
-    def hold(mesh, state, m, k, parity, node, stencil, constants, free, motion, t, bd):
-        """Registers of this thread's slots of tile ``k``: node, stencil row, constants (inverse mass, damping,
-        multiplicity), free flags, motion (displacement of buffer ``parity``, velocity, acceleration; the force is
-        the first step's)."""
+    def hold(mesh, state, m, k, parity, node, stencil, held, t, bd):
+        """This thread's slots of tile ``k``: node and stencil row into registers; into ``held`` [slot, DOF, :]
+        (shared) the per-DOF constants (:data:`INVERSE_MASS`, :data:`DAMPING`, :data:`MULTIPLICITY`, :data:`FREE`)
+        and the motion (:data:`U`: displacement of buffer ``parity``, :data:`V`, :data:`A`; :data:`F` will hold
+        the force)."""
         for r in range(SLOTS):
             s = t + r * bd
             n = mesh.slot_node[k * mesh.tile + s] if s < mesh.tile else -1
@@ -66,19 +73,18 @@ def build(device, items, sync, tiles, step):
                     stencil[r, j] = mesh.slot_stencil[n, j]
                 for c in range(2):
                     d = 2 * n + c
-                    constants[r, c, 0] = mesh.mass_inv[d]
-                    constants[r, c, 1] = mesh.damping[d]
-                    constants[r, c, 2] = mesh.multiplicity[d]
-                    free[r, c] = mesh.free[d]
-                    motion[r, c, 0] = state.u[m, parity, d]
-                    motion[r, c, 1] = state.v[m, d]
-                    motion[r, c, 2] = state.a[m, d]
+                    held[s, c, INVERSE_MASS] = mesh.mass_inv[d]
+                    held[s, c, DAMPING] = mesh.damping[d]
+                    held[s, c, MULTIPLICITY] = mesh.multiplicity[d]
+                    held[s, c, FREE] = mesh.free[d]
+                    held[s, c, U] = state.u[m, parity, d]
+                    held[s, c, V] = state.v[m, d]
+                    held[s, c, A] = state.a[m, d]
 
     @device
-    def step_slots(mesh, k, u, u_next, dt, coef, target, fe, scale, rows, nrows, node, stencil, constants, free,
-                   motion, t, bd):
-        """One time step of this thread's slots (:func:`.tiles.step_nodes` on registers): the next displacement
-        into ``u_next`` and the registers, the velocity, acceleration and force into the registers."""
+    def step_slots(mesh, k, u, u_next, dt, coef, target, fe, scale, rows, nrows, node, stencil, held, t, bd):
+        """One time step of this thread's slots (:func:`.tiles.step_nodes` on what :func:`hold` holds): the next
+        displacement into ``u_next`` and ``held``, the velocity, acceleration and force into ``held``."""
         for r in range(SLOTS):
             s = t + r * bd
             if s < mesh.tile:
@@ -89,31 +95,30 @@ def build(device, items, sync, tiles, step):
                                            coef, target, fe, scale)
                     for c in range(2):
                         f = fx if c == 0 else fy
-                        mass_inv, damping, multiplicity = constants[r, c, 0], constants[r, c, 1], constants[r, c, 2]
-                        v, a = verlet(dt, mass_inv, damping, f, motion[r, c, 1], motion[r, c, 2])
-                        res, ext = residual_terms(free[r, c], multiplicity, damping, f, v)
+                        damping = held[s, c, DAMPING]
+                        v, a = verlet(dt, held[s, c, INVERSE_MASS], damping, f, held[s, c, V], held[s, c, A])
+                        res, ext = residual_terms(held[s, c, FREE] != 0.0, held[s, c, MULTIPLICITY], damping, f, v)
                         rows[0, s] += res
                         rows[1, s] += ext
-                        un = predict(motion[r, c, 0], v, a, dt)
-                        motion[r, c, 0] = un
-                        motion[r, c, 1] = v
-                        motion[r, c, 2] = a
-                        motion[r, c, 3] = f
+                        held[s, c, U] = predict(held[s, c, U], v, a, dt)
+                        held[s, c, V] = v
+                        held[s, c, A] = a
+                        held[s, c, F] = f
                     for c in range(2):
-                        u_next[2 * n + c] = motion[r, c, 0]
-                    layer_rows(mesh, n, motion[r, 0, 0], rows, s)
+                        u_next[2 * n + c] = held[s, c, U]
+                    layer_rows(mesh, n, held[s, 0, U], rows, s)
 
     @device
-    def release(state, m, node, motion, t, bd):
-        """The registers' velocity, acceleration and force into the state (the end of a launch with steps)."""
+    def release(state, m, node, held, t, bd):
+        """The held velocity, acceleration and force into the state (the end of a launch with steps)."""
         for r in range(SLOTS):
             n = node[r]
             if n >= 0:
                 for c in range(2):
                     d = 2 * n + c
-                    state.v[m, d] = motion[r, c, 1]
-                    state.a[m, d] = motion[r, c, 2]
-                    state.f[m, d] = motion[r, c, 3]
+                    state.v[m, d] = held[t + r * bd, c, V]
+                    state.a[m, d] = held[t + r * bd, c, A]
+                    state.f[m, d] = held[t + r * bd, c, F]
 
     def resident(law, launch, mesh, state, control):
         """Up to ``launch.nsteps`` time steps of the minimisation of every listed realisation (module docstring)."""
@@ -133,11 +138,9 @@ def build(device, items, sync, tiles, step):
         ue = cuda.local.array(8, float64)
         strain = cuda.local.array((4, 3), float64)
         runs = cuda.local.array(5, float64)  # control.runs, then the last residual
+        held = cuda.shared.array((MAX_TILE, 2, HELD), float64)
         node = cuda.local.array(SLOTS, int32)
         stencil = cuda.local.array((SLOTS, 4), int32)
-        constants = cuda.local.array((SLOTS, 2, 3), float64)
-        free = cuda.local.array((SLOTS, 2), int8)
-        motion = cuda.local.array((SLOTS, 2, 4), float64)  # u, v, a, f
         for j in range(4):
             runs[j] = control.runs[m, j]
         runs[4] = control.last[m]
@@ -148,7 +151,7 @@ def build(device, items, sync, tiles, step):
         limit = state.ny[m] - margin if margin > 0 else state.ny[m] + 1
         nrows = LAYER_ROW + mesh.nlayer
         load_stencils(mesh, part, coef, target, t, bd)
-        hold(mesh, state, m, part, (done + 1) % 2, node, stencil, constants, free, motion, t, bd)
+        hold(mesh, state, m, part, (done + 1) % 2, node, stencil, held, t, bd)
         verdict = RUNNING
         if not judged:  # stopped before this step was judged (a full event buffer): the drive of its state first
             sums(mesh, state, m, (done + 1) % 2, leaves, counts, t, bd)
@@ -168,7 +171,7 @@ def build(device, items, sync, tiles, step):
             time += launch.dt
             elements(law, mesh, part, u, state, m, fe, flags, True, limit, control.record[m], False, t, bd, ue, strain)
             step_slots(mesh, part, u, u_next, launch.dt, coef, target, fe, drive_out[1], rows, nrows, node, stencil,
-                       constants, free, motion, t, bd)
+                       held, t, bd)
             for j in range(t, 3, bd):
                 state.flags[m, parity, part, j] = flags[j]
             publish(rows, nrows, mesh.tile, state.partials[m, parity, part], t, bd)
@@ -182,7 +185,7 @@ def build(device, items, sync, tiles, step):
             verdict = judge(mesh, state, control, m, part, G, parity, done, time, leaves, counts, runs, shared)
             judged = 0 if verdict == EVENTS_FULL else 1
         if steps > 0 and verdict != BARRIER_TIMEOUT:
-            release(state, m, node, motion, t, bd)
+            release(state, m, node, held, t, bd)
             elements(law, mesh, part, state.u[m, done % 2], state, m, fe, flags, True, limit, 0, True, t, bd, ue,
                      strain)
         finish(mesh, state, control, m, part, G, verdict, done, judged, time, drive_out, runs, shared, counts)
