@@ -17,7 +17,6 @@ may change from launch to launch. A full event buffer stops the launch *before* 
 (:data:`EVENTS_FULL`, the rows it needs in ``needed``); the next launch judges it first.
 """
 
-import math
 from types import SimpleNamespace
 
 from numba import cuda, float64, int32, int64
@@ -128,26 +127,10 @@ def build(device, items, sync, tiles):
         return RUNNING
 
     @device
-    def power_root(x):
-        return x ** 0.5
-
-    @device
-    def square_root(x):
-        return math.sqrt(x)
-
-    def judged_by(root):
-        """The verdict on a step with the residual's root taken by ``root``."""
-        @device
-        def judge(mesh, state, control, m, part, G, parity, done, time, leaves, counts, runs, shared):
-            """Every thread of every block, after the step's sums: the verdict on step ``done``."""
-            res, ext = leaves[0, 0], leaves[1, 0]
-            value = root(res / ext) if ext > 0.0 else root(res)
-            return decide(mesh, state, control, m, part, G, parity, done, time, counts, runs, shared, value)
-        return judge
-
-    @device
-    def decide(mesh, state, control, m, part, G, parity, done, time, counts, runs, shared, value):
-        """The verdict on step ``done`` of residual ``value`` (:func:`judged_by`): events recorded, criteria."""
+    def judge(mesh, state, control, m, part, G, parity, done, time, leaves, counts, runs, shared):
+        """Every thread of every block, after the step's sums: the verdict on step ``done``."""
+        res, ext = leaves[0, 0], leaves[1, 0]
+        value = (res / ext) ** 0.5 if ext > 0.0 else res ** 0.5
         count = shared[1]
         if control.record[m] and counts[2] > 0:
             if count + counts[2] > control.events.shape[1]:
@@ -155,11 +138,9 @@ def build(device, items, sync, tiles):
             record_events(mesh, state, control, m, part, G, parity, count, time)
             if cuda.threadIdx.x == 0:
                 shared[1] = count + counts[2]
-        decision = criteria(control, m, value, counts[0], counts[1], done, runs)
+        verdict = criteria(control, m, value, counts[0], counts[1], done, runs)
         cuda.syncthreads()
-        return decision
-
-    judge = judged_by(power_root)
+        return verdict
 
     @device
     def finish(mesh, state, control, m, part, G, verdict, done, judged, time, drive_out, runs, shared, counts):
@@ -256,4 +237,4 @@ def build(device, items, sync, tiles):
             judged = 0 if verdict == EVENTS_FULL else 1
         finish(mesh, state, control, m, part, G, verdict, done, judged, time, drive_out, runs, shared, counts)
 
-    return SimpleNamespace(minimise=minimise, drive=drive, sums=sums, judge_sqrt=judged_by(square_root), finish=finish)
+    return SimpleNamespace(minimise=minimise, drive=drive, sums=sums, judge=judge, finish=finish)
