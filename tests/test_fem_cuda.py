@@ -99,11 +99,13 @@ def test_every_kernel_compiles_for_sm_90_with_one_grid_barrier_per_step_no_spill
         assert figures["target"] == "sm_90", name
         assert figures["float_atomics"] == [], name  # no atom. or red. on .f16/.f32/.f64
         assert figures["shared_bytes"] <= 48 * 1024, name  # static shared memory of one block
-        # the minimisation kernels' one barrier site sits in their time-step loop, with one poll; no other kernel has
-        assert figures["grid_barriers"] == figures["barrier_spins"] == (name.split(":")[1] in minimisers), name
+        # the minimisation kernels' one barrier arrival sits in their time-step loop, its poll after it (the compiler
+        # may copy the poll's load); no other kernel has either
+        minimiser = name.split(":")[1] in minimisers
+        assert figures["grid_barriers"] == minimiser and (figures["barrier_spins"] > 0) == minimiser, name
         # no spills, and the minimisation kernels under their cap
         assert figures["spill_store_bytes"] == figures["spill_load_bytes"] == 0, (name, figures)
-        if name.split(":")[1] in minimisers:
+        if minimiser:
             assert figures["registers"] <= MAX_REGISTERS, (name, figures)
     print({name: {k: figures[k] for k in ("registers", "stack_bytes", "block_barriers", "shared_bytes")}
            for name, figures in result.items() if name.split(":")[1] in minimisers})

@@ -171,11 +171,12 @@ def test_blocks_that_never_meet_raise_an_error_instead_of_hanging():
     print(json.dumps(out))
     """)
     for name in ("tiles:2", "resident:3"):
-        assert result[name]["error"].startswith("BarrierTimeout: ") and "did not meet at a barrier" in result[name]["error"]
+        error = result[name]["error"]
+        assert error.startswith("BarrierTimeout: ") and "did not meet at a barrier" in error
         assert result[name]["seconds"] < 60
     # a device that cannot hold the 3 blocks of a realisation: the resident kernel is refused before a launch
-    assert result["resident:2"]["error"] == ("ValueError: cuda: the resident kernel needs the 3 blocks of a realisation "
-                                             "at once; the device holds 2 (choose kernel='tiles')")
+    assert result["resident:2"]["error"] == ("ValueError: cuda: the resident kernel needs the 3 blocks of a "
+                                             "realisation at once; the device holds 2 (choose kernel='tiles')")
 
 
 def test_both_kernels_meet_once_per_step_and_pass_the_same_block_barriers():
@@ -240,11 +241,13 @@ def test_the_resident_kernel_stops_by_the_quiet_window_and_the_margin_and_drives
             sim = kicked(CudaBackend(kernel=kernel), amplitude=0.0)
             ny = sim.model.epsy.shape[1]
             runs.append([list(sim.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2]), state(sim)])  # margin
-            sim = Simulation(FemParams(**free, backend="cuda"), MESH, CudaBackend(kernel=kernel), response=free_response)
+            sim = Simulation(FemParams(**free, backend="cuda"), MESH, CudaBackend(kernel=kernel),
+                             response=free_response)
             sim.loading.step(False)
             sim.loading.step(True)
             sim.backend.advance(3)
-            runs.append([[0, 3], state(sim) + [sim.backend.read(name)[0].tobytes().hex() for name in ("ubar", "lever")]])
+            lever = [sim.backend.read(name)[0].tobytes().hex() for name in ("ubar", "lever")]
+            runs.append([[0, 3], state(sim) + lever])
         out[kernel] = runs
     print(json.dumps(out))
     """)

@@ -210,12 +210,12 @@ def part_sanity(out, budget):
         backend = CudaBackend(groups=groups, kernel=kernel)
         gpu = kicked(dataclasses.replace(params, backend="cuda"), mesh, backend, response)
         gpu.backend.advance(steps)
-        states[kernel, groups] = gpu.backend.read("u", "v", "idx")
+        u, v, idx = states[kernel, groups] = gpu.backend.read("u", "v", "idx")
         last = time.perf_counter() - start
-        emit(out, part="sanity", kernel=kernel, groups=groups, blocks_used=sorted(gpu.backend.batch.launcher.groups_used),
-             seconds=last, u_vs_cpu=float(np.abs(states[kernel, groups][0] - reference[0]).max()
-                                          / np.abs(reference[0]).max()),
-             wells_equal_cpu=bool(np.array_equal(states[kernel, groups][2], reference[2])))
+        emit(out, part="sanity", kernel=kernel, groups=groups,
+             blocks_used=sorted(gpu.backend.batch.launcher.groups_used), seconds=last,
+             u_vs_cpu=float(np.abs(u - reference[0]).max() / np.abs(reference[0]).max()),
+             wells_equal_cpu=bool(np.array_equal(idx, reference[2])))
     first = next(iter(states.values()))
     emit(out, part="sanity", spreads=len(states), same_bytes_for_every_spread_and_kernel=all(
         same_bytes(first, state) for state in states.values()))

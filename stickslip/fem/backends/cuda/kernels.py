@@ -33,8 +33,8 @@ __all__ = ["kernels_for", "KERNELS", "MAX_REGISTERS", "MINIMISERS"]
 
 #: Every kernel of :func:`kernels_for`: the two minimisation kernels (:mod:`.minimise`, the default, and
 #: :mod:`.resident`), then the small ones.
-KERNELS = ("minimise", "resident", "prime", "layer_sums", "evaluate", "residual_rows", "residual", "wells_hold", "load", "add_u",
-           "shift_wells", "zero_motion")
+KERNELS = ("minimise", "resident", "prime", "layer_sums", "evaluate", "residual_rows", "residual", "wells_hold", "load",
+           "add_u", "shift_wells", "zero_motion")
 
 #: Registers per thread of the minimisation kernels at most (two blocks of 128 threads and more fit an SM).
 MAX_REGISTERS = 128

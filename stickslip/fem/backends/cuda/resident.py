@@ -55,7 +55,7 @@ def build(device, items, sync, tiles, step):
     verlet, residual_terms, predict = items.verlet, items.residual_terms, items.predict
     barrier, load_stencils, elements, publish = sync.barrier_acquire, tiles.load_stencils, tiles.elements, tiles.publish
     clear, layer_rows, stencil_force = tiles.clear, tiles.layer_rows, tiles.stencil_force
-    drive, sums, judge, finish = step.drive, step.sums, step.judge, step.finish
+    drive, sums, judge, resume, start, finish = step.drive, step.sums, step.judge, step.resume, step.start, step.finish
 
     @device
     def hold(mesh, state, m, k, parity, node, stencil, motion, t, bd):
@@ -142,26 +142,12 @@ def build(device, items, sync, tiles, step):
         node = cuda.local.array(SLOTS, int32)
         stencil = cuda.local.array((SLOTS, 4), int32)
         motion = cuda.local.array((SLOTS, 2, 7), float64)
-        for j in range(4):
-            runs[j] = control.runs[m, j]
-        runs[4] = control.last[m]
-        if t == 0:
-            shared[1] = control.nevent[m]
-        done, judged, time = control.done[m], control.judged[m], state.clock[m]
-        margin = control.margin[m]
-        limit = state.ny[m] - margin if margin > 0 else state.ny[m] + 1
+        done, judged, time, limit = resume(state, control, m, runs, shared, t)
         nrows = LAYER_ROW + mesh.nlayer
         load_stencils(mesh, part, coef, target, t, bd)
         hold(mesh, state, m, part, (done + 1) % 2, node, stencil, motion, t, bd)
-        verdict = RUNNING
-        if not judged:  # stopped before this step was judged (a full event buffer): the drive of its state first
-            sums(mesh, state, m, (done + 1) % 2, leaves, counts, t, bd)
-            drive(launch, mesh, state, m, leaves, drive_out)
-            sums(mesh, state, m, done % 2, leaves, counts, t, bd)
-            verdict = judge(mesh, state, control, m, part, G, done % 2, done, time, leaves, counts, runs, shared)
-            judged = 0 if verdict == EVENTS_FULL else 1
-        else:
-            sums(mesh, state, m, done % 2, leaves, counts, t, bd)
+        verdict, judged = start(launch, mesh, state, control, m, part, G, done, judged, time, leaves, counts, runs,
+                                shared, drive_out, t, bd)
         passed = 0
         steps = 0
         while verdict == RUNNING and steps < launch.nsteps:
