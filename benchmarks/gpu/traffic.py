@@ -91,7 +91,8 @@ def main():
         model, _ = stack_model(params, mesh, derived_constants(params, mesh))
         layout = build_layout(model, mesh)
         print(f"N = 1458, {plates} plates: {layout.nnode} nodes in {layout.ntile} tiles of {layout.tile}, "
-              f"{layout.ni} interface elements")
+              f"{layout.ni} interface elements; a tile uses at most {np.diff(layout.tile_triplet_ptr).max()} stencil "
+              f"triplets and touches at most {np.diff(layout.tile_element_ptr).max()} elements")
         for kernel, G, label in (("tiles", layout.ntile, "one realisation, a block per tile"),
                                  ("tiles", 1, "batches, a block per realisation"),
                                  ("resident", layout.ntile, "a block per tile")):

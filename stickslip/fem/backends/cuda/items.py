@@ -22,6 +22,12 @@ from ..cpu.dynamics import _verlet_velocity
 __all__ = ["build"]
 
 
+def _python(function):
+    """The plain Python function of a numba-compiled ``function`` (itself where numba's JIT is off:
+    ``NUMBA_DISABLE_JIT=1``, as in the GPU check's smoke mode)."""
+    return getattr(function, "py_func", function)
+
+
 def build(jit, law_class):
     """The work items compiled by ``jit`` for laws of class ``law_class``.
 
@@ -38,11 +44,11 @@ def build(jit, law_class):
         ``plate_rows``, ``interface_element``, ``gathered``, ``predict``, ``verlet``, ``residual_terms``,
         and the scalar references ``equivalent`` (strain) and ``well`` (search).
     """
-    equivalent = jit(equivalent_strain.py_func)
-    strain_of = jit(element_strain.py_func)
-    well = jit(well_index.py_func)
-    verlet = jit(_verlet_velocity.py_func)
-    factor = jit(law_class.deviatoric_factor.py_func)
+    equivalent = jit(_python(equivalent_strain))
+    strain_of = jit(_python(element_strain))
+    well = jit(_python(well_index))
+    verlet = jit(_python(_verlet_velocity))
+    factor = jit(_python(law_class.deviatoric_factor))
 
     def plate_rows(coef, target, b, nb, lo, hi, u):
         """The node's two rows of ``K_p u`` from its stencil triplets ``lo:hi`` (the CPU's ``_triplet`` order).
