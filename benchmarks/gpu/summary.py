@@ -33,10 +33,12 @@ def main(directory):
             continue
         base = cpu.get(r["plates"])
         ratio = f"{r['element_steps_per_s'] / base['element_steps_per_s']:.0f}x" if base else "(no CPU baseline)"
+        compiled = (f"; {r['registers']} registers, {r['local_bytes_per_thread']} B local" if "registers" in r
+                    else "")
         print(f"  N {r['N']} plates {r['plates']} batch {r['batch']:4d} {r['kernel']:8s} blocks/realisation "
               f"{r['blocks_per_realisation']:4d} x {r['threads_per_block']} threads (tiles {r['tiles']}, "
-              f"{r['co_resident_blocks']} co-resident): {r['us_per_step']:10.2f} us {r['us_per_realisation_step']:9.3f}"
-              f" us {r['element_steps_per_s']:.3e} {ratio}")
+              f"{r['co_resident_blocks']} co-resident{compiled}): {r['us_per_step']:10.2f} us "
+              f"{r['us_per_realisation_step']:9.3f} us {r['element_steps_per_s']:.3e} {ratio}")
     for plates, r in sorted(cpu.items()):
         print(f"  CPU one core, plates {plates}: {r['us_per_step']:.1f} us per step, {r['element_steps_per_s']:.3e} "
               "element-steps/s")
