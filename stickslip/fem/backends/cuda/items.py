@@ -80,7 +80,8 @@ def build(jit, law_class):
         ``epsy`` [ni, >= ny] the held yield strains; ``fe`` [8] receives the element force; the element's
         well is written if ``owner``, its strain and stress if ``owner`` and ``store`` (another tile may compute
         the same element: the well search does not depend on where it starts, so both find the same wells).
-        ``ue`` [8], ``strain`` [4, 3] scratch. Returns ``(moved, top)``: 1 if a Gauss point changed well, and the largest well of the element.
+        ``ue`` [8], ``strain`` [4, 3] scratch. Returns ``(moved, top)``: 1 if a Gauss point changed well, and the
+        largest well of the element.
         """
         for a in range(8):
             ue[a] = u[dofs[e, a]]

@@ -174,6 +174,8 @@ class Launcher:
         ------
         BarrierTimeout
             If a realisation's blocks did not meet at a barrier.
+        ValueError
+            If the device cannot hold the blocks of one realisation of the resident kernel at once.
         """
         nsteps = STEPS_PER_LAUNCH if nsteps is None else nsteps
         with launching():
