@@ -120,4 +120,6 @@ def test_without_qdldl_and_its_wheel_the_preflight_stops_the_check_at_once(tmp_p
     summary = (out / "summary.txt").read_text()
     assert status == 1
     assert "No module named 'qdldl'" in (out / "gpu.log").read_text()
-    assert "parts: preflight FAILED, " in summary and summary.count("MISSING") == len(PARTS) - 1
+    # the warmup ran beside the preflight (it needs qdldl too: it failed or was stopped); no part after them started
+    assert re.search(r"parts: preflight FAILED, warmup (FAILED|MISSING), " + ", ".join(
+        f"{part} MISSING" for part in PARTS[2:]), summary), summary

@@ -33,7 +33,7 @@ export GPU_CHECK_REFERENCE=$DEVICE/reference/FixedLever_historic.h5
 start=$SECONDS
 check="$PY benchmarks/gpu/gpu_check.py"
 # name:limit on a GPU:limit in the smoke mode [s], in the order they run (gpu_check.py says what each measures)
-PREFLIGHT="preflight:30:45"
+PREFLIGHT="preflight:60:120"  # beside the warmup, whose limit is longer: no time of the call
 WARMUP="warmup:80:170"
 PARTS="fidelity:75:90 speed:110:50 sanity:35:30 events:50:40"
 CPU_STEP="cpu-step:280:150"  # beside the parts, after the warmup
