@@ -85,7 +85,8 @@ class Budget:
     """The seconds left to a part (``GPU_CHECK_BUDGET``, from the part's start; unlimited if unset)."""
 
     def __init__(self):
-        self.end = time.perf_counter() + float(os.environ.get("GPU_CHECK_BUDGET", "inf")) - RESERVE
+        self.total = float(os.environ.get("GPU_CHECK_BUDGET", "inf")) - RESERVE
+        self.end = time.perf_counter() + self.total
 
     def left(self):
         return self.end - time.perf_counter()
@@ -282,8 +283,9 @@ def part_fidelity(out, budget):
                          quiet_steps=SIZES["quiet_steps"], max_increments=SIZES["batch_increments"], backend="cuda")
 
     last = 0.0
-    for kernel in KERNELS:
-        if not budget.allows(out, "fidelity", 1.5 * last, check="batch member = alone", kernel=kernel):
+    for kernel in KERNELS:  # the first needs a quarter of the part's budget left
+        if not budget.allows(out, "fidelity", 1.5 * last or budget.total / 4, check="batch member = alone",
+                             kernel=kernel):
             continue
         start = time.perf_counter()
         for seed in seeds:
