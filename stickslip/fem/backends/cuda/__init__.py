@@ -69,15 +69,19 @@ class CudaBackend(Backend):
     groups : int, optional
         Blocks a realisation is spread over in a minimisation at most (default: as many as its tiles and the
         device allow, :class:`.launch.Launcher`); the results do not depend on it.
+    kernel : str, optional
+        The minimisation kernel: ``"tiles"`` (the default) or ``"resident"`` (:class:`.launch.Launcher`); the
+        results do not depend on it.
     """
 
     name = "cuda"
     summary = "NVIDIA GPU (numba-cuda): whole minimisations on the device, batches of runs in one launch"
 
-    def __init__(self, threads=1, member=None, groups=None):
+    def __init__(self, threads=1, member=None, groups=None, kernel="tiles"):
         self.threads = int(threads)
         self.member = member
         self.groups = groups
+        self.kernel = kernel
         self.model = self.batch = self.slot = self.mesh = None
         self.device_mesh = None
         self._epsy = None  # the yield strains held (the host array they came from: a rollback may hold them again)
@@ -93,19 +97,19 @@ class CudaBackend(Backend):
         if self.member is not None:
             return self.bound(model, mesh, self.member.ensemble.batch_for(model, mesh), epsy)
         return self.bound(model, mesh, DeviceBatch(self.device_mesh or DeviceMesh(model, mesh), model.law, 1,
-                                                   self.groups), epsy)
+                                                   self.groups, self.kernel), epsy)
 
     def for_model(self, model, epsy):
         from .batch import DeviceBatch
 
         if self.member is not None:
             return self.bound(model, self.mesh, self.member.ensemble.batch_for(model, self.mesh), epsy)
-        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups), epsy)
+        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups, self.kernel), epsy)
 
     def bound(self, model, mesh, batch, epsy):
         """A backend for ``model`` on ``mesh`` holding the yield strains ``epsy`` [ni, ny] in a free slot of ``batch``,
         at rest at the origin."""
-        bound = CudaBackend(self.threads, self.member, self.groups)
+        bound = CudaBackend(self.threads, self.member, self.groups, self.kernel)
         bound.model, bound.mesh, bound.batch, bound.device_mesh = model, mesh, batch, batch.mesh
         bound.slot = batch.attach(model, bound)
         bound._epsy = epsy
@@ -172,7 +176,7 @@ class CudaBackend(Backend):
         return self.batch.wells_hold(self.slot)
 
 
-def run_ensemble(runs, groups=None):
+def run_ensemble(runs, groups=None, kernel="tiles"):
     """Run several simulations of one mesh on the GPU as one batch: one thread per run, shared launches.
 
     Parameters
@@ -182,6 +186,8 @@ def run_ensemble(runs, groups=None):
         :func:`stickslip.fem.run.simulate_to_file` with its parameters and output file).
     groups : int, optional
         Blocks per realisation at most (default: spread over the device).
+    kernel : str, optional
+        The minimisation kernel (:class:`CudaBackend`).
 
     Returns
     -------
@@ -195,13 +201,13 @@ def run_ensemble(runs, groups=None):
     """
     from .ensemble import Ensemble
 
-    ensemble = Ensemble(len(runs), groups)
+    ensemble = Ensemble(len(runs), groups, kernel)
     members = [ensemble.join() for _ in runs]  # every run is a member before any minimisation is launched
     results, errors = [None] * len(runs), [None] * len(runs)
 
     def one(i):
         try:
-            results[i] = runs[i](CudaBackend(member=members[i], groups=groups))
+            results[i] = runs[i](CudaBackend(member=members[i], groups=groups, kernel=kernel))
         except BaseException as error:  # reported after the others ended
             errors[i] = error
         finally:

@@ -41,12 +41,14 @@ class DeviceBatch:
     size : int
     groups : int, optional
         Blocks per realisation of a minimisation at most (:class:`.launch.Launcher`).
+    kernel : str, optional
+        The minimisation kernel (:class:`.launch.Launcher`; default ``"tiles"``).
     """
 
-    def __init__(self, mesh, law, size, groups=None):
+    def __init__(self, mesh, law, size, groups=None, kernel="tiles"):
         self.mesh, self.law, self.size = mesh, law, int(size)
         self.state = DeviceState(mesh, size)
-        self.launcher = Launcher(mesh, law, groups)
+        self.launcher = Launcher(mesh, law, groups, kernel=kernel)
         self._free = list(range(self.size))
         self._lock = threading.Lock()
 
