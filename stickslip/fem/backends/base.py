@@ -24,7 +24,11 @@ Statuses of :meth:`Backend.minimise`: :data:`CONVERGED`, :data:`MARGIN`, :data:`
 
 import abc
 
-__all__ = ["Backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED", "read_only"]
+__all__ = ["Backend", "BACKENDS", "register_backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED",
+           "read_only"]
+
+#: Backend classes by name (:func:`register_backend`): the choices of the ``backend`` parameter.
+BACKENDS = {}
 
 #: The state fields a backend holds (module docstring).
 FIELDS = ("u", "v", "a", "f", "idx", "eps", "sig", "target", "ubar", "lever", "t")
@@ -39,6 +43,14 @@ QUIET = 2
 MAX_ITER_REACHED = -1
 
 
+def register_backend(cls):
+    """Register a backend class (class decorator); its ``name`` becomes a choice of the ``backend`` parameter."""
+    if cls.name in BACKENDS:
+        raise ValueError(f"backend {cls.name!r} is registered twice")
+    BACKENDS[cls.name] = cls
+    return cls
+
+
 def read_only(array):
     """A view of ``array`` that cannot be written (what a CPU backend's :meth:`Backend.read` hands out)."""
     view = array.view()
@@ -49,7 +61,9 @@ def read_only(array):
 class Backend(abc.ABC):
     """How the numbers of the fem model are computed; after :meth:`prepare` it owns the state.
 
-    Class attributes: ``name`` (the value of the ``backend`` parameter), ``summary`` (one line).
+    Class attributes: ``name`` (the value of the ``backend`` parameter), ``summary`` (one line), and, for a
+    device backend that runs several runs together, ``run_ensemble(runs)`` (each ``run(backend)`` made with a
+    backend of the ensemble; returns what each returned; the ``fem`` solver's GPU batches).
     Attributes of a prepared backend: ``model`` (the :class:`..model.Model` it computes, read only)
     and ``threads``.
     """

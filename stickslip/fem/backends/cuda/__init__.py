@@ -25,7 +25,7 @@ import threading
 
 import numpy as np
 
-from ..base import Backend
+from ..base import Backend, register_backend
 
 __all__ = ["CudaBackend", "run_ensemble"]
 
@@ -48,6 +48,7 @@ def _why_not():
     return f"{reason}; run on a machine with an NVIDIA GPU or choose a CPU backend (structured, assembled)"
 
 
+@register_backend
 class CudaBackend(Backend):
     """The fem model on an NVIDIA GPU (module docstring).
 
@@ -76,6 +77,11 @@ class CudaBackend(Backend):
     @classmethod
     def unavailable(cls):
         return _why_not()
+
+    @staticmethod
+    def run_ensemble(runs, groups=None):
+        """Run several simulations of one mesh on the GPU together: :func:`run_ensemble`."""
+        return run_ensemble(runs, groups)
 
     def prepare(self, model, mesh):
         from .batch import DeviceBatch  # numba-cuda is optional: imported when a run asks for it
