@@ -25,6 +25,12 @@ def test_code_hash_follows_package_imports():
     assert len(code.code_hash("stickslip.h5io")) == 16
 
 
+def test_a_module_of_another_package_is_followed_into_this_one(toy_plugins):
+    sources = code.module_sources("stickslip_toy")  # a third-party plugin: one file importing the package
+    assert {"stickslip_toy", "stickslip.registry", "stickslip.formats.analysis_file"} <= set(sources.values())
+    assert len(code.code_hash("stickslip_toy")) == 16
+
+
 def test_the_public_api_is_in_no_plugins_code_hash(tmp_path, monkeypatch):
     # stickslip/__init__.py binds the API (stickslip.api, runs, results, ...): its imports are not the plugins'
     sources = {p.relative_to(code.ROOT).as_posix() for p in code.module_sources("stickslip.solvers.fem")}

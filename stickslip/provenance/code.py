@@ -21,8 +21,9 @@ params trigger reruns exactly the jobs whose code changed, and what depends on t
   analysis writes, ``"dmu_sig0"``; the database's ``_column("code_hash", ...)``): a new vocabulary
   entry changes the hash of the jobs whose code names it, and of no other.
 
-Imports made by name at run time (``importlib.import_module("...")``) are not seen; plugins do not
-use them. A third-party module (outside the package) is hashed by its own source file.
+A module of another package (a third-party plugin, law or backend) is followed the same way through
+the modules of its own package and of this one; other libraries (numpy, ...) are not hashed. Imports
+made by name at run time (``importlib.import_module("...")``) are not seen; plugins do not use them.
 """
 
 import ast
@@ -30,6 +31,7 @@ import hashlib
 import importlib.util
 from functools import lru_cache
 from pathlib import Path
+from types import MappingProxyType
 
 __all__ = ["ENTRY_TABLES", "module_sources", "code_hash", "plugin_code_hash"]
 
@@ -41,27 +43,43 @@ ROOT = Path(__file__).resolve().parent.parent
 ENTRY_TABLES = {"vocabulary.py": "QUANTITIES"}
 
 
-def _module_file(name):
-    """Return the source file of package module ``name`` (dotted), or None if it is not one."""
-    parts = name.split(".")
-    if parts[0] != PACKAGE:
+def _root(top):
+    """The directory of the top-level package ``top`` (or the file of a top-level module), found without importing
+    it; None if it has no source (a built-in, an extension module) or does not exist."""
+    if top == PACKAGE:
+        return ROOT
+    spec = importlib.util.find_spec(top)
+    if spec is None:
         return None
-    base = ROOT.joinpath(*parts[1:])
+    if spec.submodule_search_locations:
+        return Path(next(iter(spec.submodule_search_locations))).resolve()
+    return Path(spec.origin).resolve() if spec.origin and Path(spec.origin).is_file() else None
+
+
+def _module_file(name, roots):
+    """Return the source file of module ``name`` (dotted) under ``roots`` (top-level name -> its :func:`_root`), or
+    None if it is not one."""
+    parts = name.split(".")
+    root = roots.get(parts[0])
+    if root is None or root.suffix == ".py":
+        return root if root is not None and len(parts) == 1 else None
+    base = root.joinpath(*parts[1:])
     for candidate in (base.with_suffix(".py"), base / "__init__.py"):
         if candidate.is_file():
             return candidate
     return None
 
 
-def _package_inits(name):
-    """Return the ``__init__.py`` files run when importing ``name``: its parent packages."""
+def _package_inits(name, roots):
+    """Return the ``__init__.py`` files run when importing ``name``: its parent packages (with their names)."""
     parts = name.split(".")
-    files = []
+    inits = []
     for depth in range(1, len(parts)):
-        init = ROOT.joinpath(*parts[1:depth]) / "__init__.py"
-        if init.is_file():
-            files.append(init)
-    return files
+        parent = ".".join(parts[:depth])
+        init = _module_file(parent, roots)
+        if init is not None and init.name == "__init__.py":
+            inits.append((parent, init))
+    return inits
 
 
 def _imported_names(path, name):
@@ -86,14 +104,6 @@ def _imported_names(path, name):
     return names
 
 
-def _outside_file(module):
-    """The source file of a module outside the package (a third-party plugin or part)."""
-    spec = importlib.util.find_spec(module)
-    if spec is None or not spec.origin or not Path(spec.origin).is_file():
-        raise ValueError(f"module {module!r} has no source file to hash")
-    return Path(spec.origin).resolve()
-
-
 @lru_cache(maxsize=None)
 def module_sources(module, parts=frozenset()):
     """Return the package source files that importing ``module`` runs.
@@ -101,25 +111,26 @@ def module_sources(module, parts=frozenset()):
     Parameters
     ----------
     module : str
-        Dotted module name, e.g. ``"stickslip.solvers.lever"``; outside the
-        package, only the module's own file is returned.
+        Dotted module name, e.g. ``"stickslip.solvers.lever"``, or of another package (then the modules
+        of its package and of this one are followed).
     parts : frozenset[str], optional
         Modules of parts chosen by name (:class:`stickslip.registry.Choice`): an import of one of them in
         an ``__init__.py`` is not followed (module docstring).
 
     Returns
     -------
-    tuple[pathlib.Path, ...]
-        Sorted absolute paths.
+    Mapping[pathlib.Path, str]
+        Absolute path -> dotted module name, sorted by path (read only).
 
     Raises
     ------
     ValueError
         If ``module`` has no source file.
     """
-    start = _module_file(module)
+    roots = {top: _root(top) for top in {PACKAGE, module.partition(".")[0]}}
+    start = _module_file(module, roots)
     if start is None:
-        return (_outside_file(module),)
+        raise ValueError(f"module {module!r} has no source file to hash")
     seen = {}
     pending = [(module, start)]
     while pending:
@@ -127,15 +138,14 @@ def module_sources(module, parts=frozenset()):
         if path in seen:
             continue
         seen[path] = name
-        for init in _package_inits(name):
-            pending.append((init.parent.relative_to(ROOT.parent).as_posix().replace("/", "."), init))
+        pending.extend(_package_inits(name, roots))
         if path == ROOT / "__init__.py":
             continue  # the public API's imports: see the module's docstring
         for imported in _imported_names(path, name):
-            source = _module_file(imported)
+            source = _module_file(imported, roots)
             if source is not None and not (path.name == "__init__.py" and imported in parts):
                 pending.append((imported, source))
-    return tuple(sorted(seen))
+    return MappingProxyType(dict(sorted(seen.items())))
 
 
 def _stamp(path):
@@ -177,12 +187,13 @@ def _entry_table_text(path, table, names):
 
 
 def _digest(sources):
-    """sha256 of the sources (sorted paths), each by its name and bytes; an entry table by the entries named."""
+    """sha256 of the sources (path -> module name, by path), each by its module name and bytes (so that a copy of a
+    package elsewhere hashes alike); an entry table by the entries that the others name."""
     tables = {ROOT / relative: table for relative, table in ENTRY_TABLES.items()}
     named = frozenset().union(*(_strings(_stamp(path)) for path in sources if path not in tables))
     digest = hashlib.sha256()
-    for path in sources:
-        digest.update((path.relative_to(ROOT.parent).as_posix() if path.is_relative_to(ROOT) else path.name).encode())
+    for path in sorted(sources):
+        digest.update((sources[path] + (".__init__" if path.name == "__init__.py" else "")).encode())
         digest.update(b"\0")
         digest.update(_entry_table_text(path, tables[path], named) if path in tables else path.read_bytes())
         digest.update(b"\0")
@@ -212,8 +223,8 @@ def code_hash(modules, parts=frozenset()):
     time), so the workflow, which asks once per job, hashes each set of sources once.
     """
     modules = (modules,) if isinstance(modules, str) else tuple(modules)
-    sources = tuple(sorted(set().union(*(module_sources(module, frozenset(parts)) for module in modules))))
-    stamp = tuple(_stamp(path) for path in sources)
+    sources = {path: name for module in modules for path, name in module_sources(module, frozenset(parts)).items()}
+    stamp = tuple(_stamp(path) for path in sorted(sources))
     cached = _hashes.get(stamp)
     if cached is None:
         cached = _hashes[stamp] = _digest(sources)
