@@ -17,6 +17,10 @@ of the plugin's kind (:data:`ENTRY_POINT_GROUPS`) that names the module to impor
     [project.entry-points."stickslip.solvers"]
     mysolver = "mypackage.mysolver"
 
+(:mod:`stickslip.discovery`; docs/writing-a-plugin.md). The parts a solver's run chooses by name with a
+parameter (the ``fem`` solver's interface laws and backends, with their own entry-point groups) are declared
+as its :class:`Choice` s, so that a run's code hash covers the part it chooses and no other.
+
 Call signatures by kind (checked when a plugin registers):
 
 - ``solver``: ``run(params, output, *, threads, inputs)``: write one file of the

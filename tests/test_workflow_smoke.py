@@ -86,7 +86,8 @@ def test_an_unused_extension_reruns_nothing_a_change_in_the_cusp_law_reruns_the_
     listed = subprocess.run([sys.executable, "-c", "from stickslip import registry; from stickslip.fem.laws import "
                              "INTERFACE_LAWS; from stickslip.fem.backends import BACKENDS; "
                              "print(sorted(INTERFACE_LAWS), sorted(BACKENDS), sorted(registry.available('solver')))"],
-                            env={**os.environ, "PYTHONPATH": python_path(site)}, capture_output=True, text=True)
+                            env={**os.environ, "PYTHONPATH": python_path(site)}, cwd=tmp_path, capture_output=True,
+                            text=True)
     assert "'cusp-copy'" in listed.stdout and "'structured-copy'" in listed.stdout and "'toy-spring-block'" in \
         listed.stdout, listed.stderr  # registered: found in their packages
     assert planned() == {}
