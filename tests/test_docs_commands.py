@@ -100,6 +100,7 @@ def test_the_plugin_package_of_the_docs_runs_a_study_and_reruns_what_its_law_cha
     site = tmp_path / "site"
     files = install_from_page(site)
     assert {"mystudy/laws.py", "mystudy/block.py", "mystudy/largest.py", "mystudy/figures.py"} <= set(files)
+    (tmp_path / "clone").mkdir()
     workflow = copy_workflow(tmp_path / "clone")
     (workflow / "my-study.yaml").write_text(files["my-study.yaml"])
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba-cache"))  # kernels of the page's law: not shared
