@@ -6,8 +6,9 @@ generic functions of :mod:`.generic`, compiled for its type. Built in: :class:`.
 wells: the linear response). :mod:`.wells` finds the well a strain lies in. A new law: one module
 with its class decorated by :func:`.generic.register_law`, in this package (every module of it is
 imported) or in another package that names it in the entry-point group :data:`ENTRY_POINT_GROUP`
-(docs/writing-a-plugin.md). The modules of the laws a run does not choose are not in its code hash
-(:func:`stickslip.provenance.code.plugin_code_hash`): nothing here imports them but the discovery.
+(docs/writing-a-plugin.md). A run's code hash covers the law it chooses, not the others
+(:func:`stickslip.provenance.code.plugin_code_hash`: the imports of a law's module in this file, the
+re-exports below and the discovery, do not count).
 """
 
 from ...discovery import import_modules, load_entry_points
@@ -18,9 +19,9 @@ from .generic import (INTERFACE_LAWS, LAWS, backward_barrier, deviatoric_factor,
 from .smooth import Smooth
 from .wells import well_index
 
-__all__ = ["LAWS", "INTERFACE_LAWS", "ENTRY_POINT_GROUP", "Cusp", "Smooth", "Elastic", "make_law", "register_law", "mirrored",
-           "deviatoric_factor", "well_energy", "forward_barrier", "backward_barrier", "well_stress", "energy_density",
-           "well_index", "extra_parameters"]
+__all__ = ["LAWS", "INTERFACE_LAWS", "ENTRY_POINT_GROUP", "Cusp", "Smooth", "Elastic", "make_law", "register_law",
+           "mirrored", "deviatoric_factor", "well_energy", "forward_barrier", "backward_barrier", "well_stress",
+           "energy_density", "well_index", "extra_parameters"]
 
 #: The entry-point group through which other packages add interface laws (a module registering them).
 ENTRY_POINT_GROUP = "stickslip.fem.laws"
