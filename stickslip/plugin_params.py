@@ -295,11 +295,11 @@ def did_you_mean(name, choices):
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
-def params_to_dict(instance):
+def params_to_dict(instance, *, every=False):
     """Return the parameters as a JSON-safe dict (tuples become lists), in field order.
 
     Fields declared with ``extension=True`` are left out while they have their default; those
-    declared with ``extension="<field>"`` while that field has its default too.
+    declared with ``extension="<field>"`` while that field has its default too; ``every=True``: none is.
     """
     fields = {f.name: f for f in dataclasses.fields(instance)}
 
@@ -313,7 +313,7 @@ def params_to_dict(instance):
         return at_default(f.name) and (extension is True or at_default(extension))
 
     return {f.name: list(v) if isinstance(v := getattr(instance, f.name), tuple) else v
-            for f in fields.values() if not left_out(f)}
+            for f in fields.values() if every or not left_out(f)}
 
 
 _JSON_TYPES = {int: "integer", float: "number", bool: "boolean", str: "string"}

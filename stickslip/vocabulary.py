@@ -65,7 +65,7 @@ QUANTITIES = {
                               "class (initial, load, micro, single, multi) or a sequence's (single, multi)"),
     "plugin": _q("str", _LABEL, "the plugin that ran"),
     "plugin_version": _q("str", _LABEL, "the plugin's algorithm version"),
-    "code_hash": _q("str", _ID, "hash of the package sources the plugin imports"),
+    "code_hash": _q("str", _ID, "hash of the code the job ran: its plugin, what it imports, the parts it chose"),
     "package_version": _q("str", _LABEL, "the stickslip version that ran"),
     "git_commit": _q("str", _ID, "the git commit of the code (missing outside a git tree)"),
     "git_dirty": _q("bool", _LABEL, "tracked files differed from the commit"),

@@ -1,7 +1,8 @@
-"""The fem core's seams, through the worked examples of docs/developing.md ("Extending the fem solver").
+"""The fem core's seams, through the worked examples of docs/writing-a-plugin.md ("A law") and docs/developing.md
+("Extending the fem solver").
 
 The law example (``SoftCusp``) and the backend example (``CountingBackend``) are taken from the
-document as they are and run in a fresh Python (registering a law or a backend is global):
+documents as they are and run in a fresh Python (registering a law or a backend is global):
 
 - a new law is one module: with ``c = 1`` it is the cusp bit for bit, its parameter is checked by name;
 - the backend owns the state: the example backend counts every transfer between its state and the host
@@ -26,16 +27,16 @@ from stickslip.fem.parameters import FemParams
 from stickslip.fem.simulation import Simulation
 from stickslip.mesh import MeshParams, build_stack_mesh
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "developing.md"
+DOCS = [Path(__file__).resolve().parents[1] / "docs" / name for name in ("developing.md", "writing-a-plugin.md")]
 
 pytestmark = pytest.mark.slow
 
 
 def _example(name):
-    """The python block of docs/developing.md that defines ``name``."""
-    blocks = re.findall(r"```python\n(.*?)```", DOC.read_text(), re.S)
+    """The python block of the documents that defines ``name``."""
+    blocks = [block for doc in DOCS for block in re.findall(r"```python\n(.*?)```", doc.read_text(), re.S)]
     found = [block for block in blocks if f"class {name}(" in block]
-    assert len(found) == 1, f"docs/developing.md: one example defining {name} expected"
+    assert len(found) == 1, f"docs: one example defining {name} expected"
     return found[0]
 
 

@@ -87,6 +87,9 @@ def test_every_table_is_typed_with_its_units(study):
     assert str(runs["blocks"].dtype) == "Int64" and str(runs["n"].dtype) == "Int64"
     fem = runs[runs["plugin"] == "fem"].iloc[0]
     assert fem["params.N"] == fem["blocks"] == 9 and fem["params.max_increments"] == 200
+    # extensions at their default, which the records leave out, show their value; a lever run has none
+    assert (fem["params.interface_law"], fem["params.backend"], fem["params.law_params"]) == ("cusp", "structured", [])
+    assert runs.loc[runs["plugin"] == "lever", "params.interface_law"].isna().all()
     units = runs.attrs["units"]
     assert units["params.k_drive"] == "G/h^2" == units["k_drive"] and units["params.duration"] == "s"
     for name, frame in (("runs", runs), ("events", study.events()), ("figures", study.figures()),

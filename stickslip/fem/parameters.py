@@ -204,9 +204,10 @@ class FemParams:
             raise ParameterError("parameter 'junction_strengthening': junction aging needs thermal activation; "
                                  "expected temperature > 0 or junction_strengthening = 0")
         if not getattr(INTERFACE_LAWS[self.interface_law], "junction_aging", False):
+            aging = [name for name, law in INTERFACE_LAWS.items() if getattr(law, "junction_aging", False)]
             raise ParameterError(f"parameter 'junction_strengthening': law '{self.interface_law}' has a stress that "
                                  "depends on the well's width, so a junction cannot widen it at rest; expected "
-                                 "interface_law 'cusp' or junction_strengthening = 0")
+                                 f"interface_law {' or '.join(map(repr, aging))} or junction_strengthening = 0")
         _refuse_beyond_clock(self, "junction_attempt_rate", self.junction_attempt_rate)
         _refuse_endless_redraws(self)
 
@@ -220,8 +221,9 @@ class FemParams:
             raise ParameterError(f"parameter 'relaxation': law '{law.name}' has a curvature that the elastic stiffness "
                                  "does not bound, so 'exact' cannot converge; expected 'dynamic'")
         if self.temperature > 0.0 and not law.thermal:
-            raise ParameterError(f"parameter 'temperature': law '{law.name}' has no exact barriers for thermal "
-                                 "activation; expected 0")
+            raise ParameterError(f"parameter 'temperature': law '{law.name}' is not thermal (the exact sampling of "
+                                 "the hops needs an exact backward barrier and barriers quasi-concave in eps_eq "
+                                 "within a well); expected 0")
 
 
 def _stretch(params):

@@ -21,6 +21,7 @@ import _sqlite3
 import ctypes
 import dataclasses
 import itertools
+import json
 import math
 import numbers
 import signal
@@ -37,7 +38,7 @@ from sqlalchemy import select, text
 
 from .. import registry
 from ..h5io import FileFormatError
-from ..plugin_params import parse_value
+from ..plugin_params import params_to_dict, parse_value
 from ..vocabulary import dtype_matches, expand_json, quantity, typed
 from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
@@ -362,6 +363,23 @@ def _units(frame):
     return frame
 
 
+def _defaults_filled(frame):
+    """``frame`` (columns ``kind``, ``plugin``, ``params``: JSON) with every parameter of a registered plugin in its
+    ``params``: one that a run's record leaves out (an extension at its default, a parameter added after the run was
+    made) gets its default, so that it is shown as the value it had (``interface_law`` "cusp"), not as missing.
+
+    Rows of a plugin not registered here (a mesh, another package's plugin not installed) are left as they are.
+    """
+    defaults = {}
+    for kind, plugin in set(zip(frame["kind"], frame["plugin"])):
+        if kind in registry.KINDS and plugin in registry.available(kind):
+            defaults[kind, plugin] = params_to_dict(registry.get(kind, plugin).params(), every=True)
+    frame["params"] = [text if (kind, plugin) not in defaults or not isinstance(text, str)
+                       else json.dumps({**defaults[kind, plugin], **json.loads(text)})
+                       for kind, plugin, text in zip(frame["kind"], frame["plugin"], frame["params"])]
+    return frame
+
+
 def runs(database=DEFAULT_DATABASE, **filters):
     """Return the runs, with their simulation parameters where they are simulations.
 
@@ -381,7 +399,8 @@ def runs(database=DEFAULT_DATABASE, **filters):
         (``code_hash``, ``package_version``, ``git_commit``, ``git_dirty``, ``python_version``, ...,
         ``host``), ``started_at``, ``finished_at`` (UTC datetimes), ``wall_time_s``, ``peak_memory_mib``,
         ``record_path``, then one column ``params.<name>`` per parameter of the runs' plugins (missing where a
-        plugin has no such parameter). Typed (:func:`stickslip.vocabulary.typed`), ``attrs["units"]``
+        plugin has no such parameter; a parameter its record leaves out, as an extension at its default or one
+        added later, has its default: ``params.interface_law`` "cusp"). Typed (:func:`stickslip.vocabulary.typed`), ``attrs["units"]``
         (``params.<name>``: None; :func:`stickslip.study` gives the plugins' units); ordered by kind, plugin,
         run id.
 
@@ -402,7 +421,7 @@ def runs(database=DEFAULT_DATABASE, **filters):
                + [f"r.{c}" for c in tail])
     statement = text(f"SELECT {', '.join(columns)} FROM runs AS r LEFT JOIN simulations AS s ON s.run_id = r.run_id"
                      f"{where} ORDER BY r.kind, r.plugin, r.run_id").bindparams(**bound)
-    return _units(typed(expand_json(_frame(database, statement), "params", prefix="params.")))
+    return _units(typed(expand_json(_defaults_filled(_frame(database, statement)), "params", prefix="params.")))
 
 
 def events(database=DEFAULT_DATABASE, **filters):

@@ -30,7 +30,11 @@ import abc
 
 import numpy as np
 
-__all__ = ["Backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED", "read_only", "unbounded_wells"]
+__all__ = ["Backend", "BACKENDS", "register_backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED",
+           "read_only", "unbounded_wells"]
+
+#: Backend classes by name (:func:`register_backend`): the choices of the ``backend`` parameter.
+BACKENDS = {}
 
 #: The state fields a backend holds (module docstring).
 FIELDS = ("u", "v", "a", "f", "idx", "eps", "sig", "target", "ubar", "lever", "t")
@@ -43,6 +47,14 @@ MARGIN = 0
 QUIET = 2
 #: Status of a minimisation: ``max_iter`` steps did not converge.
 MAX_ITER_REACHED = -1
+
+
+def register_backend(cls):
+    """Register a backend class (class decorator); its ``name`` becomes a choice of the ``backend`` parameter."""
+    if cls.name in BACKENDS:
+        raise ValueError(f"backend {cls.name!r} is registered twice")
+    BACKENDS[cls.name] = cls
+    return cls
 
 
 def read_only(array):
@@ -61,7 +73,9 @@ def unbounded_wells(ni):
 class Backend(abc.ABC):
     """How the numbers of the fem model are computed; after :meth:`prepare` it owns the state.
 
-    Class attributes: ``name`` (the value of the ``backend`` parameter), ``summary`` (one line).
+    Class attributes: ``name`` (the value of the ``backend`` parameter), ``summary`` (one line), and, for a
+    device backend that runs several runs together, ``run_ensemble(runs)`` (each ``run(backend)`` made with a
+    backend of the ensemble; returns what each returned; the ``fem`` solver's GPU batches).
     Attributes of a prepared backend: ``model`` (the :class:`..model.Model` it computes, read only)
     and ``threads``.
     """

@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..base import Backend
+from ..base import Backend, register_backend
 
 __all__ = ["CudaBackend", "run_ensemble"]
 
@@ -56,6 +56,7 @@ class Checkpoint(NamedTuple):
     epsy: object
 
 
+@register_backend
 class CudaBackend(Backend):
     """The fem model on an NVIDIA GPU (module docstring).
 
@@ -89,6 +90,11 @@ class CudaBackend(Backend):
     @classmethod
     def unavailable(cls):
         return _why_not()
+
+    @staticmethod
+    def run_ensemble(runs, groups=None):
+        """Run several simulations of one mesh on the GPU together: :func:`run_ensemble`."""
+        return run_ensemble(runs, groups)
 
     def prepare(self, model, mesh, epsy):
         from .batch import DeviceBatch  # numba-cuda is optional: imported when a run asks for it
