@@ -55,10 +55,11 @@ import numpy as np
 
 from .. import __version__, formats
 from ..arithmetic import check_resume, decisive
-from ..h5io import (FileFormatError, attribute, copy_file, open_file, read_array, read_table, write_attrs,
-                    write_dataset)
+from ..h5io import (CorruptFileError, FileFormatError, attribute, copy_file, open_file, read_array, read_table,
+                    write_attrs, write_dataset)
 from ..mesh import load_mesh, save_mesh
 from ..output_safety.atomic import atomic_output
+from ..stored_rows import first_unstored_row
 
 __all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
            "read_increments", "read_run_attrs", "stored_increments", "RunFile", "describe", "check_arithmetic"]
@@ -271,12 +272,20 @@ def _check(file):
 
 
 def stored_increments(file):
-    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``).
+    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``), checked against its
+    datasets.
+
+    Every growable dataset of ``/state`` and ``/increments`` must hold ``nstored`` rows, and the file must store
+    the last of them (its chunk was written, :mod:`stickslip.stored_rows`): a file resized and told a larger
+    ``nstored`` is refused here, before any row is read, in a few lookups of each chunk index (a chunk missing
+    before the last is refused where the rows are read, :func:`stickslip.h5io.read_array`).
 
     Raises
     ------
     FileFormatError
         If ``nstored`` is not an integer >= 0, or more than the file's rows (``/state/t``).
+    stickslip.h5io.CorruptFileError
+        If a growable dataset holds fewer rows or the file does not store its row ``nstored - 1``.
     """
     nstored = attribute(file, "nstored", "int")
     times = file.get("state/t")
@@ -285,7 +294,21 @@ def stored_increments(file):
     if not 0 <= nstored <= times.shape[0]:
         raise FileFormatError(f"{file.filename}: attribute 'nstored' is {nstored}, expected 0 ... the "
                               f"{times.shape[0]} rows of /state/t")
+    for dataset in _growable(file) if nstored else ():
+        stored = dataset.shape[0] if first_unstored_row(dataset, nstored - 1, nstored) is None else \
+            first_unstored_row(dataset, 0, nstored)
+        if stored < nstored:
+            raise CorruptFileError(f"{file.filename}: attribute 'nstored' is {nstored}, but {dataset.name} stores "
+                                   f"{stored} rows at most (declared: {dataset.shape[0]}): the file is damaged or not "
+                                   "what it claims; remake it (rerun the job that wrote it)")
     return nstored
+
+
+def _growable(file):
+    """The datasets of ``/state`` and ``/increments`` with an unlimited first axis (one row per increment)."""
+    groups = [file.get(name) for name in ("state", "increments")]
+    return [item for group in groups if isinstance(group, h5py.Group) for item in group.values()
+            if isinstance(item, h5py.Dataset) and item.maxshape and item.maxshape[0] is None]
 
 
 def read_params(file):

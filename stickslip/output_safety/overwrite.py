@@ -15,6 +15,7 @@ file too damaged to open (a truncated copy) is moved aside, never deleted (:func
 """
 
 import errno
+import filecmp
 import glob
 import json
 import os
@@ -294,8 +295,8 @@ def write_text_output(path, text, *, overwrite=False):
     Parameters
     ----------
     path : str or pathlib.Path
-    text : str
-        The whole content (UTF-8).
+    text : str or Iterable[str]
+        The whole content (UTF-8), or its pieces in order (written as they come: the text is never held whole).
     overwrite : bool, optional
 
     Returns
@@ -306,13 +307,14 @@ def write_text_output(path, text, *, overwrite=False):
     Raises
     ------
     OutputExistsError
-        If ``path`` exists with other content and ``overwrite`` is false.
+        If ``path`` exists with other content and ``overwrite`` is false (the new text is then discarded).
     """
     path = Path(path)
-    data = text.encode()
-    replaced = path.exists() and (path.is_dir() or path.read_bytes() != data)
-    if replaced and not overwrite and not path.is_dir():
-        raise OutputExistsError(path, "exists with other content", OVERWRITE_HINT)
     with atomic_output(path) as tmp:
-        tmp.write_bytes(data)
+        with open(tmp, "w", encoding="utf-8", newline="") as stream:
+            for piece in [text] if isinstance(text, str) else text:
+                stream.write(piece)
+        replaced = path.exists() and (path.is_dir() or not filecmp.cmp(tmp, path, shallow=False))
+        if replaced and not overwrite and not path.is_dir():
+            raise OutputExistsError(path, "exists with other content", OVERWRITE_HINT)
     return replaced
