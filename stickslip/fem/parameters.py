@@ -10,6 +10,7 @@ import math
 import warnings
 
 from ..formats import fem_run
+from ..h5io import FileFormatError
 from ..plugin_params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
@@ -304,8 +305,12 @@ def stored_params(file):
     Raises
     ------
     stickslip.h5io.FileFormatError
-        If the file is not a ``fem-run`` file of the current version.
-    stickslip.plugin_params.ParameterError
-        If its parameters are not those of a :class:`FemParams`.
+        If the file is not a ``fem-run`` file of the current version, or its parameters are not those of a
+        :class:`FemParams` (a damaged file: the message names it).
     """
-    return parse_params(FemParams, fem_run.read_params(file), owner=f"{file.filename}: params")
+    stored = fem_run.read_params(file)
+    try:
+        return parse_params(FemParams, stored, owner=f"{file.filename}: params")
+    except ParameterError as error:
+        raise FileFormatError(f"{file.filename}: attribute 'params' holds parameters no fem run has ({error}): the "
+                              "file is damaged or not what it claims; remake it (rerun the job that wrote it)") from None

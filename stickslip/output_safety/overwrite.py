@@ -177,7 +177,7 @@ def _difference(stored, identity, describe):
     return None
 
 
-def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe=_description):
+def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe=_description, damage=None):
     """Raise :class:`OutputExistsError` if ``path`` exists and holds another run than ``identity``.
 
     Parameters
@@ -194,6 +194,10 @@ def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe
         this run.
     describe : callable, optional
         ``describe(stored) -> str``: what the stored values say the file is.
+    damage : callable, optional
+        ``damage(stored) -> str or None``: why stored values that differ from ``identity`` cannot be those
+        of any run of this writer (a damaged file: a parameter no run has), or None; the message then says
+        the file is damaged, not another run.
 
     Returns
     -------
@@ -218,12 +222,13 @@ def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe
                                       "a readable HDF5 file)", hint) from None
     difference = _difference(stored, identity, describe)
     if difference is not None:
-        raise OutputExistsError(path, difference, hint)
+        why = damage(stored) if damage is not None else None
+        raise OutputExistsError(path, f"holds {describe(stored)} that is damaged: {why}" if why else difference, hint)
     return True
 
 
 @contextmanager
-def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
+def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT, damage=None):
     """The one rule of the command line: write ``path`` in the block only if it is absent, this run, or ``overwrite``.
 
     Before the block: an absent output or one that holds this run (:func:`refuse_other_run`) is
@@ -244,6 +249,8 @@ def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
         Replace another run (``--overwrite``).
     hint : str, optional
         The end of the refusal's message: how to overwrite (default: the command line's ``--overwrite``).
+    damage : callable, optional
+        Why a differing output is damaged rather than another run (:func:`refuse_other_run`).
 
     Raises
     ------
@@ -256,7 +263,7 @@ def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
         print(f"stickslip: {path}: not a readable HDF5 file; moved it to {aside}, starting the run over",
               file=sys.stderr)
     try:
-        refuse_other_run(path, identity, hint=hint)
+        refuse_other_run(path, identity, hint=hint, damage=damage)
     except OutputExistsError as error:
         if not overwrite:
             raise

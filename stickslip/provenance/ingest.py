@@ -22,9 +22,11 @@ carry, never file names, and needs no edit for a new solver or analysis:
 import fcntl
 import json
 import shutil
+import sqlite3
 from contextlib import contextmanager
 from pathlib import Path
 
+import sqlalchemy.exc
 from sqlalchemy import delete, insert
 from sqlalchemy.orm import Session
 
@@ -217,6 +219,22 @@ def ingest(database, records, *, rebuild=False):
             with Session(engine) as session, session.begin():
                 for record_file in iterate(records, desc="ingest", unit="record"):
                     events += _ingest_record(session, read_record(record_file), record_file)
+        except sqlalchemy.exc.DatabaseError as error:
+            raise _database_error(database, error) from None
         finally:
             engine.dispose()
     return {"records": len(records), "slip events": events}
+
+
+#: SQLite's words for a file that is not a database, or a damaged one.
+_DAMAGED = ("file is not a database", "malformed", "corrupt")
+
+
+def _database_error(database, error):
+    """The one-line error of SQLite failing on ``database`` during an ingest (the database is left as it was)."""
+    cause = str(getattr(error, "orig", None) or error).strip()
+    if isinstance(getattr(error, "orig", None), sqlite3.DatabaseError) and any(word in cause for word in _DAMAGED):
+        return FileFormatError(f"{database}: not a readable SQLite database ({cause}): it is damaged or not a "
+                               "database; `stickslip db rebuild` remakes it from the provenance records (left as it "
+                               "was)")
+    return FileFormatError(f"{database}: the ingest failed in SQLite ({cause}); the database is left as it was")
