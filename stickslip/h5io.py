@@ -33,7 +33,6 @@ whose HDF5 metadata fail their checksums raises :class:`CorruptFileError` naming
 import json
 import math
 import os
-import resource
 import time
 from pathlib import Path
 
@@ -44,6 +43,7 @@ import pandas as pd
 from .output_safety.errors import OutputError
 from .output_safety.torn_chunk import committed_rows
 from .output_safety.write_guard import WriteGuard
+from .machine_memory import room_left, size_text
 from .stored_rows import data_elsewhere, first_unstored_row
 
 __all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs", "copy_file",
@@ -98,30 +98,6 @@ class ReadBudgetError(FileFormatError):
     """Reading a dataset would take more memory than the budget of one read (:func:`read_budget`)."""
 
 
-def _meminfo(field):
-    """A field of /proc/meminfo [B] (None where there is none)."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as info:
-            for line in info:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
-
-
-def _own(field):
-    """A field of /proc/self/status [B] (0 where there is none)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return 0
-
-
 def read_budget():
     """The most one read of a dataset may allocate [B]: half of what this process can still allocate.
 
@@ -135,12 +111,7 @@ def read_budget():
     float
         [B]; ``inf`` where nothing limits it.
     """
-    room = [_meminfo("MemAvailable")]
-    for limit, used in ((resource.RLIMIT_AS, "VmSize"), (resource.RLIMIT_DATA, "VmData")):
-        soft = resource.getrlimit(limit)[0]
-        if soft != resource.RLIM_INFINITY:
-            room.append(max(0, soft - _own(used)))
-    budget = 0.5 * min((r for r in room if r is not None), default=math.inf)
+    budget = 0.5 * room_left()
     capped = os.environ.get(READ_LIMIT_VARIABLE)
     if capped:
         try:
@@ -157,14 +128,6 @@ def _selected_shape(shape, selection):
         return tuple(shape)
     out = [len(range(*item.indices(n))) for item, n in zip(items, shape) if isinstance(item, slice)]
     return tuple(out) + tuple(shape[len(items):])
-
-
-def _size(nbytes):
-    """``nbytes`` as a short text (B, KiB, MiB, GiB)."""
-    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if nbytes >= scale:
-            return f"{nbytes / scale:.3g} {unit}"
-    return f"{nbytes:.0f} B"
 
 
 def _nbytes(dataset, shape):
@@ -194,9 +157,10 @@ def _check_storage(dataset, shape):
     expansion = MAX_EXPANSION if filters & _COMPRESSING else 1
     chunk = _nbytes(dataset, dataset.chunks) if dataset.chunks else 0.0
     if nbytes > stored * expansion + chunk:
+        compressed = " compressed" if expansion > 1 else ""
         raise CorruptFileError(f"{dataset.file.filename}: dataset {dataset.name} declares {shape} {dataset.dtype} "
-                               f"({_size(nbytes)}) but stores {_size(stored)}{' compressed' if expansion > 1 else ''}: "
-                               "the file is damaged or not what it claims; remake it (rerun the job that wrote it)")
+                               f"({size_text(nbytes)}) but stores {size_text(stored)}{compressed}: the file is "
+                               "damaged or not what it claims; remake it (rerun the job that wrote it)")
 
 
 def check_budget(nbytes, what):
@@ -211,8 +175,8 @@ def check_budget(nbytes, what):
     """
     budget = read_budget()
     if nbytes > budget:
-        raise ReadBudgetError(f"{what} would take {_size(nbytes)}, beyond the memory budget of one read "
-                              f"({_size(budget)}: half of what this process can still allocate, or "
+        raise ReadBudgetError(f"{what} would take {size_text(nbytes)}, beyond the memory budget of one read "
+                              f"({size_text(budget)}: half of what this process can still allocate, or "
                               f"{READ_LIMIT_VARIABLE})")
 
 

@@ -42,6 +42,7 @@ __all__ = [
     "params_to_dict",
     "json_schema",
     "describe",
+    "value_range",
 ]
 
 
@@ -379,5 +380,25 @@ def describe(cls):
             doc += f" (one of: {listed})"
         elif choices is not None:
             doc += f" (one of: {', '.join(map(str, choices))})"
+        bounds = value_range(f.metadata)
+        if bounds:
+            doc += f" (range: {bounds})"
         rows.append((f.name, type_name, f.default, f.metadata.get("unit", ""), doc))
     return rows
+
+
+def value_range(meta):
+    """The bounds of a parameter (for a tuple: of every element) as text, e.g. ``> 0, <= 8``; "" if it has none.
+
+    Parameters
+    ----------
+    meta : Mapping
+        A field's metadata (:func:`param`).
+
+    Returns
+    -------
+    str
+    """
+    bounds = [(">=", meta.get("minimum")), (">", meta.get("exclusive_minimum")), ("<=", meta.get("maximum"))]
+    return ", ".join(f"{sign} {value if isinstance(value, int) else format(value, 'g')}" for sign, value in bounds
+                     if value is not None)

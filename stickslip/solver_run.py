@@ -12,6 +12,7 @@ import warnings
 import numpy as np
 
 from . import registry
+from .errors import SolverError
 from .numba_options import set_num_threads
 from .output_safety.atomic import check_output
 from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
@@ -84,9 +85,12 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     stickslip.plugin_params.ParameterError
         For an unknown parameter or a bad value (a ``ValueError`` naming the parameter; ``threads`` and
         ``overwrite`` of another type too), or parameters this machine cannot run (the solver's ``preflight``: a
-        GPU backend without a GPU), before any file is touched.
+        GPU backend without a GPU, a run that needs more memory than the machine has), before any file is touched
+        (an output that cannot be written is said first).
     stickslip.output_safety.errors.OutputError
         If ``output`` cannot be written, or holds another run and ``overwrite`` is false.
+    stickslip.errors.SolverError
+        If the solver cannot make the run (naming ``output`` and the solver; what a ``fem`` run stored is kept).
     """
     if isinstance(threads, bool) or not isinstance(threads, numbers.Integral) or threads < 1:
         raise ParameterError(f"parameter 'threads': expected an integer >= 1, got {threads!r}")
@@ -94,11 +98,14 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
         raise ParameterError(f"parameter 'overwrite': expected True or False, got {overwrite!r}")
     plugin = registry.get("solver", solver)
     params = parse_params(plugin.params, values, owner=f"solver '{plugin.name}'")
+    check_output(output)
     if plugin.preflight is not None:
         plugin.preflight(params)
     used = set_num_threads(threads)
-    check_output(output)
     with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint,
                         damage=lambda stored: invalid_params(plugin, stored)):
-        plugin.run(params, output, threads=used, inputs={})
+        try:
+            plugin.run(params, output, threads=used, inputs={})
+        except SolverError as error:
+            raise SolverError(f"{output}: solver '{plugin.name}' cannot make this run: {error}") from None
     return plugin, params

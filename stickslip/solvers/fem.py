@@ -12,6 +12,7 @@ batches (:data:`GPU_BATCHING`, the solver's ``device_batch``).
 from .. import registry
 from ..fem.backends import make_backend
 from ..fem.backends.cuda import CudaBackend, run_ensemble
+from ..fem.memory import check_run_memory
 from ..fem.parameters import FemParams
 from ..fem.replay import EventReplay
 from ..fem.run import simulate_to_file
@@ -53,7 +54,9 @@ def stack_mesh(params, inputs):
 
 
 def can_run(params):
-    """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
+    """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)
+    or has less memory than the run needs (:func:`stickslip.fem.memory.check_run_memory`)."""
+    check_run_memory(params)
     make_backend(params.backend)
 
 
