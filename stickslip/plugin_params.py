@@ -124,7 +124,7 @@ def _convert_scalar(name, value, kind):
         if isinstance(value, str):
             return value
         raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
-    if isinstance(value, bool):
+    if isinstance(value, (bool, bytes, bytearray)):
         raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
     try:
         if kind is int:
@@ -165,7 +165,7 @@ def _convert(name, value, annotation, meta):
         if text[:1] + text[-1:] in ("[]", "()"):  # the YAML and Python forms: [1e3, 1e6]
             text = text[1:-1]
         items = [item for item in text.split(",") if item.strip()]
-    elif isinstance(value, Iterable):
+    elif isinstance(value, Iterable) and not isinstance(value, (bytes, bytearray)):
         items = list(value)
     else:
         items = [value]

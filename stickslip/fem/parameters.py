@@ -142,17 +142,17 @@ class FemParams:
                                     "protocol; > 0 the kinetic Monte Carlo protocol with a finite drive rate "
                                     "(docs/fem.md, 'Finite temperature'); energy in units of the barrier of a block a "
                                     "strain eps0 below its yield strain, G eps0^2 h^2", unit="G eps0^2 h^2", minimum=0.0,
-                               maximum=1.0, extension=True)
+                               extension=True)
     attempt_rate: float = param(1.0, "temperature > 0: attempt rate nu of a block's hop over a barrier E, at rate "
-                                     "nu exp(-E / temperature)", unit="1/time", minimum=1e-15,
-                                maximum=1e15, extension="temperature")
+                                     "nu exp(-E / temperature)", unit="1/time", exclusive_minimum=0.0,
+                                extension="temperature")
     drive_rate: float = param(1e-9, "temperature > 0: rate of the imposed shear gamma (fixed lever; free lever: of the "
-                                    "lever's drive target)", unit="eps0/time", minimum=1e-18,
-                              maximum=1.0, extension="temperature")
+                                    "lever's drive target)", unit="eps0/time", exclusive_minimum=0.0,
+                              extension="temperature")
     hold_times: tuple[float, ...] = param((), "temperature > 0: slide-hold-slide: after every slip event (every block "
                                               "of an interface changed well) the drive stops for the next of these "
                                               "times, cycled; empty: no holds", unit="time", minimum=0.0,
-                                          maximum=1e18, extension="temperature")
+                                          extension="temperature")
     hold_delay: float = param(0.0, "temperature > 0 with hold_times: the drive's advance after a slip event at "
                                    "which the hold starts (a slip before it postpones the hold)", unit="eps0",
                               minimum=0.0, maximum=1e6, extension="temperature")
@@ -164,11 +164,11 @@ class FemParams:
     junction_glass_temperature: float = param(8e-3, "junction aging: scale T_g of the depths drawn, rho(E) = "
                                                     "exp(-E / T_g) / T_g, when a block enters a well and at every "
                                                     "redraw; the typical depth grows as temperature x ln t below T_g",
-                                              unit="G eps0^2 h^2", minimum=1e-12,
+                                              unit="G eps0^2 h^2", exclusive_minimum=0.0,
                                               maximum=1e3, extension="junction_strengthening")
     junction_attempt_rate: float = param(1.0, "junction aging: a junction of depth E is redrawn at rest at the rate "
-                                              "nu_j exp(-E / temperature)", unit="1/time", minimum=1e-15,
-                                         maximum=1e15, extension="junction_strengthening")
+                                              "nu_j exp(-E / temperature)", unit="1/time", exclusive_minimum=0.0,
+                                         extension="junction_strengthening")
 
     def check(self):
         """Check conditions across fields."""
