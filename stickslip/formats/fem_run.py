@@ -294,13 +294,15 @@ def stored_increments(file):
     if not 0 <= nstored <= times.shape[0]:
         raise FileFormatError(f"{file.filename}: attribute 'nstored' is {nstored}, expected 0 ... the "
                               f"{times.shape[0]} rows of /state/t")
-    for dataset in _growable(file) if nstored else ():
-        stored = dataset.shape[0] if first_unstored_row(dataset, nstored - 1, nstored) is None else \
-            first_unstored_row(dataset, 0, nstored)
-        if stored < nstored:
-            raise CorruptFileError(f"{file.filename}: attribute 'nstored' is {nstored}, but {dataset.name} stores "
-                                   f"{stored} rows at most (declared: {dataset.shape[0]}): the file is damaged or not "
-                                   "what it claims; remake it (rerun the job that wrote it)")
+    growable = _growable(file) if nstored else []
+    if any(dataset.shape[0] < nstored or first_unstored_row(dataset, nstored - 1, nstored) is not None
+           for dataset in growable):
+        stored = {dataset.name: min(dataset.shape[0], first_unstored_row(dataset, 0, nstored) or nstored)
+                  for dataset in growable}
+        name = min(stored, key=stored.get)
+        raise CorruptFileError(f"{file.filename}: attribute 'nstored' is {nstored}, but {name} stores {stored[name]} "
+                               f"rows at most (declared: {file[name].shape[0]}): the file is damaged or not what it "
+                               "claims; remake it (rerun the job that wrote it)")
     return nstored
 
 
@@ -361,6 +363,25 @@ class RunFile:
         self.params = read_params(file)
         self.mesh = load_mesh(file["mesh"])
         self.nstored = stored_increments(file)
+        self._check_shapes()
+
+    def _check_shapes(self):
+        """Raise FileFormatError unless the linear response and the state have the shapes of the mesh (module
+        docstring), before any of them is used."""
+        ndof, nlayer = self.mesh.ndof, self.mesh.nlayer
+        expected = {"event/delta_u": (ndof,), "event/delta_eps": (self.mesh.N * self.mesh.n_interfaces, 4, 3),
+                    "event/delta_target": (nlayer,), "event/delta_lever": (1,), "state/u": (ndof,),
+                    "state/target": (nlayer,), "state/lever_target": (), "state/t": ()}
+        for name, shape in expected.items():
+            dataset = self.file.get(name)
+            per_row = name.startswith("state/")
+            found = dataset.shape if isinstance(dataset, h5py.Dataset) else None
+            found = (found[1:] if found else None) if per_row else found
+            if found != shape:
+                what = f"of shape {dataset.shape}" if isinstance(dataset, h5py.Dataset) else "missing"
+                raise FileFormatError(f"{self.file.filename}: /{name} is {what}, expected "
+                                      f"{'rows of ' if per_row else ''}{shape} (the stored mesh's): the file is "
+                                      "damaged")
 
     def state(self, increment):
         """(u, target, lever_target, t) of a stored increment; a file with further state adds a mapping of it."""

@@ -8,8 +8,10 @@ Layout of a mesh group: datasets ``coor`` [nnode, 2], ``conn`` [nelem, 4],
 
 from pathlib import Path
 
+import numpy as np
+
 from .. import formats
-from ..h5io import FileFormatError, open_file, read_array, write_attrs, write_dataset
+from ..h5io import FileFormatError, attribute, open_file, read_array, write_attrs, write_dataset
 from ..hashing import short_hash
 from ..output_safety.atomic import atomic_output
 from ..plugin_params import ParameterError, params_to_dict, parse_params
@@ -66,23 +68,45 @@ def load_mesh(group):
     Raises
     ------
     FileFormatError
-        If a dataset or attribute is missing, has the wrong rank, or the format
-        version is not :data:`MESH_FORMAT`; the message names file, group and item.
+        If a dataset or attribute is missing, has the wrong rank or a shape or numbers that do not fit the rest of
+        the mesh, or the format version is not :data:`MESH_FORMAT`; the message names file, group and item.
     """
     where = f"{group.file.filename}:{group.name}"
     missing = [name for name in _DATASETS if name not in group]
     missing += [name for name in ("N", "plates", "h", "mesh_format") if name not in group.attrs]
     if missing:
         raise FileFormatError(f"{where}: not a stickslip mesh, missing {', '.join(missing)}")
-    if int(group.attrs["mesh_format"]) != MESH_FORMAT:
+    if attribute(group, "mesh_format", "int") != MESH_FORMAT:
         raise FileFormatError(f"{where}: mesh_format {group.attrs['mesh_format']} is not the supported "
                               f"{MESH_FORMAT}; rebuild the mesh")
+    params = read_mesh_params(group)
     arrays = {name: read_array(group[name]) for name in _DATASETS}
     for name, rank in _DATASETS.items():
         if arrays[name].ndim != rank:
             raise FileFormatError(f"{where}/{name}: expected {rank} dimensions, got shape {arrays[name].shape}")
-    return LayeredMesh(**arrays, N=int(group.attrs["N"]), plates=int(group.attrs["plates"]),
-                       h=float(group.attrs["h"]))
+    _check_consistent(where, arrays, params)
+    return LayeredMesh(**arrays, N=params.N, plates=params.plates, h=params.h)
+
+
+def _check_consistent(where, arrays, params):
+    """Raise FileFormatError unless the mesh arrays fit each other and the mesh's N and plates: every shape, and
+    every node, element, layer and DOF number within its range (a damaged file is refused before it is used)."""
+    nnode, nelem, nlayer = len(arrays["coor"]), len(arrays["conn"]), 2 * params.plates - 1
+    expected = {"coor": (nnode, 2), "conn": (nelem, 4), "dofs": (nnode, 2), "elem_layer": (nelem,),
+                "layer_y": (nlayer, 2), "interface_elements": (params.plates - 1, params.N)}
+    for name, shape in expected.items():
+        if arrays[name].shape != shape:
+            raise FileFormatError(f"{where}/{name}: shape {arrays[name].shape}, expected {shape} (the mesh's other "
+                                  f"arrays, N = {params.N}, plates = {params.plates}): the file is damaged")
+    ndof = 2 * nnode
+    for name, top in (("conn", nnode), ("dofs", ndof), ("iip", ndof), ("elem_layer", nlayer),
+                      ("interface_elements", nelem)):
+        values = arrays[name]
+        if values.size and (not np.issubdtype(values.dtype, np.integer) or values.min() < 0 or values.max() >= top):
+            raise FileFormatError(f"{where}/{name}: values outside 0 ... {top - 1} (numbers of the mesh's "
+                                  "nodes, elements, layers or DOFs): the file is damaged")
+    if not all(np.all(np.isfinite(arrays[name])) for name in ("coor", "layer_y")):
+        raise FileFormatError(f"{where}: coordinates that are not finite numbers: the file is damaged")
 
 
 def read_mesh_params(group):
