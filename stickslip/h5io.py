@@ -46,9 +46,9 @@ from .output_safety.write_guard import WriteGuard
 from .machine_memory import room_left, size_text
 from .stored_rows import data_elsewhere, first_unstored_row
 
-__all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs", "copy_file",
-           "attribute", "read_budget", "check_budget", "FileFormatError", "UnreadableFileError", "CorruptFileError", "ReadBudgetError",
-           "READ_LIMIT_VARIABLE", "MAX_EXPANSION"]
+__all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs",
+           "copy_file", "attribute", "read_budget", "check_budget", "FileFormatError", "UnreadableFileError",
+           "CorruptFileError", "ReadBudgetError", "READ_LIMIT_VARIABLE", "MAX_EXPANSION"]
 
 LIBVER = ("v110", "v110")
 
@@ -131,7 +131,7 @@ def _selected_shape(shape, selection):
 
 
 def _nbytes(dataset, shape):
-    """Bytes that ``shape`` of ``dataset`` takes in memory (a variable-length element counted as :data:`_OBJECT_BYTES`)."""
+    """Bytes that ``shape`` of ``dataset`` takes in memory (a variable-length element: :data:`_OBJECT_BYTES`)."""
     itemsize = _OBJECT_BYTES if dataset.dtype.kind == "O" else dataset.dtype.itemsize
     return float(np.prod(shape, dtype=float)) * itemsize
 

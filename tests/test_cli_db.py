@@ -163,5 +163,6 @@ def test_ingest_into_a_damaged_database_is_one_line_and_leaves_it(toy_results, c
     capsys.readouterr()
     assert _run("db", "ingest", "--db", str(database), *map(str, toy_results))[0] == 2
     error = capsys.readouterr().err
-    assert error.startswith(f"stickslip: error: {database}: not a readable SQLite database (") and error.count("\n") == 1
+    assert error.startswith(f"stickslip: error: {database}: not a readable SQLite database (")
+    assert error.count("\n") == 1
     assert "`stickslip db rebuild` remakes it" in error and database.read_bytes() == before

@@ -175,7 +175,8 @@ def read_csv_columns(path, quantities, units):
     if np.any(steps <= 0):
         row = int(np.argmax(steps <= 0)) + 1
         raise FileFormatError(f"{path}: line {lines[row]}, column '{time_name}': time must increase strictly, "
-                              f"got {_cut(text[time_name].iloc[row], 40)!r} after {_cut(text[time_name].iloc[row - 1], 40)!r}")
+                              f"got {_cut(text[time_name].iloc[row], 40)!r} after "
+                              f"{_cut(text[time_name].iloc[row - 1], 40)!r}")
     return {name: values[name] for name in quantities}
 
 

@@ -122,18 +122,8 @@ def _largest_force(record):
 
 
 def force_range_warning(record, source):
-    """A one-line warning if the force record exceeds what the springs can hold, else None.
-
-    Parameters
-    ----------
-    record : stickslip.experiment.timeseries.ExperimentRecord
-    source : str
-        The force file, named in the message.
-
-    Returns
-    -------
-    str or None
-    """
+    """A one-line warning if the force record exceeds what the springs can hold, else None (``record``, and the force
+    file ``source`` named in the message, as :func:`force_rate_warning`'s)."""
     largest = _largest_force(record)
     found = float(np.max(np.abs(record.F)))
     if found <= FORCE_FACTOR * largest:

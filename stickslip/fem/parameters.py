@@ -78,8 +78,8 @@ def thermal_reach(temperature, attempt_rate, drive_rate):
 class FemParams:
     """Parameters of one simulation of the stack (see the field docs for units)."""
 
-    N: int = param(1458, "blocks per interface (mesh: 2*3^k, or small values such as 9; a run that needs more memory than "
-                         "the machine has is refused with its estimate)", minimum=3, maximum=10**6)
+    N: int = param(1458, "blocks per interface (mesh: 2*3^k, or small values such as 9; a run that needs more memory "
+                         "than the machine has is refused with its estimate)", minimum=3, maximum=10**6)
     plates: int = param(2, "number of elastic plates (n = plates - 1 interfaces)", minimum=2, maximum=6)
     seed: int = param(0, "realisation id; the disorder of element e of the interfaces uses pcg32 seed "
                          "seed*N*99 + e (within int64)", minimum=0, maximum=2**31 - 1)
@@ -106,9 +106,10 @@ class FemParams:
     weibull_k: float = param(2.0, "Weibull shape parameter of the well widths", minimum=0.1, maximum=100.0)
     deps: float = param(1e-4, "kick size in equivalent strain", unit="eps0", minimum=1e-10, maximum=0.1)
     dt_scale: float = param(1.0, "time step in units of the paper's dt = h / (2 pi c) / 10 (1 = the paper's "
-                                 "protocol; 2-4 keep the event statistics, not each event: docs/fem.md)", minimum=1e-3, maximum=8.0)
-    tol: float = param(1e-5, "minimisation: relative residual tolerance (above round-off)", minimum=1e-13,
-                        maximum=0.5)
+                                 "protocol; 2-4 keep the event statistics, not each event: docs/fem.md)", minimum=1e-3,
+                          maximum=8.0)
+    tol: float = param(1e-5, "minimisation: relative residual tolerance (below round-off, ~1e-15, never met: the "
+                                 "run ends after max_iter steps)", exclusive_minimum=0.0, maximum=0.5)
     niter_tol: int = param(20, "minimisation: consecutive steps below tol (and non-increasing); at most max_iter",
                           minimum=1, maximum=10**7)
     max_iter: int = param(10_000_000, "minimisation: maximum time steps (then the run fails)", minimum=1,
@@ -193,8 +194,8 @@ class FemParams:
                                  f"{self.max_iter} steps; expected niter_tol <= max_iter")
         if self.yield_strains == "extend" and self.eps_offset <= self.deps * self.eps0:
             raise ParameterError(f"parameter 'eps_offset': {self.eps_offset:g} lets a well be no wider than the kick "
-                                 f"deps * eps0 = {self.deps * self.eps0:g} (with yield_strains 'extend' any well may be "
-                                 "as narrow as eps_offset); expected eps_offset > deps * eps0")
+                                 f"deps * eps0 = {self.deps * self.eps0:g} (with yield_strains 'extend' any well may "
+                                 "be as narrow as eps_offset); expected eps_offset > deps * eps0")
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
@@ -325,4 +326,5 @@ def stored_params(file):
         return parse_params(FemParams, stored, owner=f"{file.filename}: params")
     except ParameterError as error:
         raise FileFormatError(f"{file.filename}: attribute 'params' holds parameters no fem run has ({error}): the "
-                              "file is damaged or not what it claims; remake it (rerun the job that wrote it)") from None
+                              "file is damaged or not what it claims; remake it (rerun the job that wrote "
+                              "it)") from None

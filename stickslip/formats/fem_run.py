@@ -219,7 +219,7 @@ def rewrite(path, **attrs):
         Root attributes to set in the copy (e.g. ``completed``, ``stop_reason``).
     """
     with open_file(path) as source, atomic_output(path) as tmp:
-        _check(source)
+        RunFile(source)  # header, mesh, the arrays' shapes and the stored rows checked before a byte is copied
         with open_file(tmp, "w") as target:
             copy_file(source, target, rows=stored_increments(source))
             write_attrs(target, attrs)

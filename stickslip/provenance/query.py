@@ -43,8 +43,8 @@ from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
 
 __all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S", "MAX_ROWS",
-           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "sql_pieces", "Pieces", "unique_names",
-           "check_bounds"]
+           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "sql_pieces", "Pieces",
+           "unique_names", "check_bounds"]
 
 #: Where the workflow writes the database of the default study (relative to the workflow directory);
 #: a study named S has ``results/S/stickslip.sqlite``.
@@ -344,6 +344,9 @@ def _pieces(database, statement, only_reading=False, time_limit=None, max_rows=N
         raise QueryError(f"{database}: the statement returns no rows; `db sql` runs queries (SELECT)") from None
     except QueryError as error:
         raise QueryError(f"{database}: {error}") from None
+    except UnicodeDecodeError as error:  # SQLite keeps no checksums: a flipped bit in a text value
+        raise QueryError(f"{database}: a text value is not UTF-8 ({error.reason} at byte {error.start}): the database "
+                         "is damaged; `stickslip db rebuild` remakes it from the provenance records") from None
     except MemoryError:  # SQLITE_NOMEM at the heap limit, or the machine's memory
         if not _HEAP.exhausted(bounds.memory):
             raise QueryError(f"{database}: the machine ran out of memory during the query, after {bounds.rows} rows "

@@ -108,7 +108,8 @@ def check_sampling(params):
         samples = params.duration * getattr(params, name)
         if samples < 2:
             raise ParameterError(f"parameter '{name}': {getattr(params, name):g} Hz over a duration of "
-                                 f"{params.duration:g} s records {samples:.3g} samples; expected duration * {name} >= 2")
+                                 f"{params.duration:g} s records {samples:.3g} samples; expected duration * {name} "
+                                 ">= 2")
 
 
 def check_memory(params):
