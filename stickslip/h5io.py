@@ -24,8 +24,8 @@ What keeps outputs safe (atomic renames, locks, free space, the write guard thro
 Files are not trusted: before a read allocates anything, :func:`read_array` checks the size the file
 declares against what it stores (a dataset cannot hold more numbers than its chunks, compressed at most
 :data:`MAX_EXPANSION` to one; rows in a chunk that was never written are not stored, :mod:`.stored_rows`)
-and against a memory budget (:func:`read_budget`: half of what this process
-can still allocate, at most ``STICKSLIP_READ_LIMIT_MIB``), and reads large selections in blocks; a file
+and against a memory budget (:func:`read_budget`: half of what this process can still allocate, at most
+``STICKSLIP_READ_LIMIT_MIB``; :func:`read_table` budgets a table whole), and reads large selections in blocks; a file
 whose HDF5 metadata fail their checksums raises :class:`CorruptFileError` naming it wherever it is read
 (:func:`open_file`). Each is one line naming the file and the dataset.
 """
@@ -40,10 +40,10 @@ import h5py
 import numpy as np
 import pandas as pd
 
+from .machine_memory import room_left, size_text
 from .output_safety.errors import OutputError
 from .output_safety.torn_chunk import committed_rows
 from .output_safety.write_guard import WriteGuard
-from .machine_memory import room_left, size_text
 from .stored_rows import data_elsewhere, first_unstored_row
 
 __all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs",

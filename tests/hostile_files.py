@@ -496,6 +496,7 @@ def _peak_mib():
 def _read(kind, path):
     """Every reader of ``kind`` on ``path``: one result each (reader, outcome, message, digest, seconds, peak)."""
     from stickslip.cli import USER_ERRORS
+    from stickslip.provenance.query import QueryError
 
     results = []
     for name, reader, compared in READERS[kind]:
@@ -505,7 +506,7 @@ def _read(kind, path):
         digest = ""
         try:
             digest, outcome, message = reader(path), "read", ""
-        except (Refused, *USER_ERRORS) as error:
+        except (Refused, QueryError, *USER_ERRORS) as error:
             message = str(error)
             outcome = "refused" if "\n" not in message and path.name in message else "FAILED"
         except _Hang:

@@ -277,19 +277,19 @@ def streamed_text(pieces, fmt):
         writer.writerow(pieces.columns)
     else:
         sys.stdout.write("[")
-    first = True
+    written = 0
     for piece in pieces:
         rows = [[c(v) for c, v in zip(convert, row)] for row in piece]
         if fmt == "csv":
             writer.writerows([["" if v is None else v for v in row] for row in rows])
-        else:
-            text = ",\n".join(json.dumps(dict(zip(pieces.columns, map(_finite, row))), allow_nan=False)
-                               for row in rows)
-            sys.stdout.write(("\n" if first else ",\n") + text if rows else "")
-            first = first and not rows
-        yield len(piece)
+        elif rows:
+            sys.stdout.write(",\n" if written else "\n")
+            sys.stdout.write(",\n".join(json.dumps(dict(zip(pieces.columns, map(_finite, row))), allow_nan=False)
+                                        for row in rows))
+        written += len(rows)
+        yield len(rows)
     if fmt == "json":
-        sys.stdout.write("]\n" if first else "\n]\n")
+        sys.stdout.write("\n]\n" if written else "]\n")
 
 
 def _finite(value):

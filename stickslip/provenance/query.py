@@ -345,8 +345,7 @@ def _pieces(database, statement, only_reading=False, time_limit=None, max_rows=N
     except QueryError as error:
         raise QueryError(f"{database}: {error}") from None
     except UnicodeDecodeError as error:  # SQLite keeps no checksums: a flipped bit in a text value
-        raise QueryError(f"{database}: a text value is not UTF-8 ({error.reason} at byte {error.start}): the database "
-                         "is damaged; `stickslip db rebuild` remakes it from the provenance records") from None
+        raise _damaged(database, f"{error.reason} at byte {error.start}") from None
     except MemoryError:  # SQLITE_NOMEM at the heap limit, or the machine's memory
         if not _HEAP.exhausted(bounds.memory):
             raise QueryError(f"{database}: the machine ran out of memory during the query, after {bounds.rows} rows "
@@ -358,11 +357,19 @@ def _pieces(database, statement, only_reading=False, time_limit=None, max_rows=N
         bound = bounds.error(database, cause)
         if bound is not None:
             raise bound from None
+        if "decode to UTF-8" in str(cause):  # a text value of a column the driver decodes itself
+            raise _damaged(database, str(cause).split(" with text ")[0]) from None
         if "authoriz" in str(cause):  # "not authorized", "authorization denied"
             cause = f"refused ({cause}): `db sql` only reads (SELECT, WITH, PRAGMA {', '.join(READ_ONLY_PRAGMAS)})"
         raise QueryError(f"{database}: query failed: {cause}") from None
     finally:
         engine.dispose()
+
+
+def _damaged(database, detail):
+    """The QueryError of a text value that is not UTF-8 (SQLite keeps no checksums: a flipped bit in a value)."""
+    return QueryError(f"{database}: a text value is not UTF-8 ({detail}): the database is damaged; `stickslip db "
+                      "rebuild` remakes it from the provenance records")
 
 
 def _frame(database, statement, **bounds):
