@@ -42,6 +42,7 @@ __all__ = [
     "params_to_dict",
     "json_schema",
     "describe",
+    "value_range",
 ]
 
 
@@ -123,7 +124,7 @@ def _convert_scalar(name, value, kind):
         if isinstance(value, str):
             return value
         raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
-    if isinstance(value, bool):
+    if isinstance(value, (bool, bytes, bytearray)):
         raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
     try:
         if kind is int:
@@ -164,7 +165,7 @@ def _convert(name, value, annotation, meta):
         if text[:1] + text[-1:] in ("[]", "()"):  # the YAML and Python forms: [1e3, 1e6]
             text = text[1:-1]
         items = [item for item in text.split(",") if item.strip()]
-    elif isinstance(value, Iterable):
+    elif isinstance(value, Iterable) and not isinstance(value, (bytes, bytearray)):
         items = list(value)
     else:
         items = [value]
@@ -379,5 +380,25 @@ def describe(cls):
             doc += f" (one of: {listed})"
         elif choices is not None:
             doc += f" (one of: {', '.join(map(str, choices))})"
+        bounds = value_range(f.metadata)
+        if bounds:
+            doc += f" (range: {bounds})"
         rows.append((f.name, type_name, f.default, f.metadata.get("unit", ""), doc))
     return rows
+
+
+def value_range(meta):
+    """The bounds of a parameter (for a tuple: of every element) as text, e.g. ``> 0, <= 8``; "" if it has none.
+
+    Parameters
+    ----------
+    meta : Mapping
+        A field's metadata (:func:`param`).
+
+    Returns
+    -------
+    str
+    """
+    bounds = [(">=", meta.get("minimum")), (">", meta.get("exclusive_minimum")), ("<=", meta.get("maximum"))]
+    return ", ".join(f"{sign} {value if isinstance(value, int) else format(value, 'g')}" for sign, value in bounds
+                     if value is not None)

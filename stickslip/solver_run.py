@@ -7,22 +7,51 @@ the same run is resumed (``fem``) or written again, another run is refused unles
 """
 
 import numbers
+import warnings
 
 import numpy as np
 
 from . import registry
+from .errors import SolverError
 from .numba_options import set_num_threads
 from .output_safety.atomic import check_output
 from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
-from .plugin_params import ParameterError, params_to_dict, parse_params
+from .plugin_params import ParameterError, ParameterWarning, params_to_dict, parse_params
 
-__all__ = ["run_identity", "run_solver"]
+__all__ = ["run_identity", "run_solver", "invalid_params"]
 
 
 def run_identity(plugin, params):
     """What a solver's output file stores about its run (root attributes): format, solver, version, parameters."""
     return {"format": plugin.produces, "solver": plugin.name, "solver_version": plugin.version,
             "params": params_to_dict(params)}
+
+
+def invalid_params(plugin, stored):
+    """Why a file of ``plugin``'s run holds parameters that no run of it has (a damaged file), or None.
+
+    Parameters
+    ----------
+    plugin : registry.Plugin
+    stored : Mapping[str, object]
+        The file's root attributes (``solver``, ``solver_version``, ``params`` decoded).
+
+    Returns
+    -------
+    str or None
+        None also for a file of another solver or version (another run, not damage).
+    """
+    if (stored.get("solver"), stored.get("solver_version")) != (plugin.name, plugin.version):
+        return None
+    if not isinstance(stored.get("params"), dict):
+        return f"its attribute 'params' is not a JSON object of parameters ({str(stored.get('params'))[:80]!r})"
+    try:
+        with warnings.catch_warnings():  # a valid run's warning is not the damage
+            warnings.simplefilter("ignore", ParameterWarning)
+            parse_params(plugin.params, stored["params"], owner=f"solver '{plugin.name}'")
+    except ParameterError as error:
+        return f"its stored parameters are not valid ({error})"
+    return None
 
 
 def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_hint=OVERWRITE_HINT):
@@ -56,9 +85,12 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     stickslip.plugin_params.ParameterError
         For an unknown parameter or a bad value (a ``ValueError`` naming the parameter; ``threads`` and
         ``overwrite`` of another type too), or parameters this machine cannot run (the solver's ``preflight``: a
-        GPU backend without a GPU), before any file is touched.
+        GPU backend without a GPU, a run that needs more memory than the machine has), before any file is touched
+        (an output that cannot be written is said first).
     stickslip.output_safety.errors.OutputError
         If ``output`` cannot be written, or holds another run and ``overwrite`` is false.
+    stickslip.errors.SolverError
+        If the solver cannot make the run (naming ``output`` and the solver; what a ``fem`` run stored is kept).
     """
     if isinstance(threads, bool) or not isinstance(threads, numbers.Integral) or threads < 1:
         raise ParameterError(f"parameter 'threads': expected an integer >= 1, got {threads!r}")
@@ -66,10 +98,14 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
         raise ParameterError(f"parameter 'overwrite': expected True or False, got {overwrite!r}")
     plugin = registry.get("solver", solver)
     params = parse_params(plugin.params, values, owner=f"solver '{plugin.name}'")
+    check_output(output)
     if plugin.preflight is not None:
         plugin.preflight(params)
     used = set_num_threads(threads)
-    check_output(output)
-    with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint):
-        plugin.run(params, output, threads=used, inputs={})
+    with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint,
+                        damage=lambda stored: invalid_params(plugin, stored)):
+        try:
+            plugin.run(params, output, threads=used, inputs={})
+        except SolverError as error:
+            raise SolverError(f"{output}: solver '{plugin.name}' cannot make this run: {error}") from None
     return plugin, params

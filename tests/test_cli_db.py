@@ -148,3 +148,21 @@ def test_a_mistyped_regime_is_refused_not_answered_with_no_rows(toy_results, cap
             _run("db", command, "--regime", "complaint")
         assert exited.value.code == 2
         assert "invalid choice: 'complaint' (choose from 'stiff', 'compliant')" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("damage", ["not a database", "cut short"])
+def test_ingest_into_a_damaged_database_is_one_line_and_leaves_it(toy_results, capsys, tmp_path, damage):
+    # the audit of 575c37a (issue 59, item 4): a sqlalchemy DatabaseError traceback
+    assert _run("db", "rebuild")[0] == 0
+    database = tmp_path / "results" / "default" / "stickslip.sqlite"
+    if damage == "cut short":
+        database.write_bytes(database.read_bytes()[:3000])
+    else:
+        database.write_bytes(os.urandom(5000))
+    before = database.read_bytes()
+    capsys.readouterr()
+    assert _run("db", "ingest", "--db", str(database), *map(str, toy_results))[0] == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"stickslip: error: {database}: not a readable SQLite database (")
+    assert error.count("\n") == 1
+    assert "`stickslip db rebuild` remakes it" in error and database.read_bytes() == before

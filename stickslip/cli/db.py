@@ -12,6 +12,9 @@ are those of ``stickslip.study(...).runs/events`` (:mod:`stickslip.provenance.fi
 """
 
 import argparse
+import csv
+import json
+import math
 import os
 import sys
 from pathlib import Path
@@ -26,6 +29,7 @@ from ..provenance.ingest import find_records, ingest
 from ..provenance.migrate import migrate
 from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
 from ..study_plan import check_study_name
+from ..vocabulary import quantity
 from ..workdir import ENVIRONMENT, find_workdir
 
 FORMATS = ("table", "csv", "json")
@@ -183,12 +187,13 @@ PIECE = 10_000
 
 def _text_of_blobs(frame):
     """``frame`` with every bytes value (an SQL blob) as its hexadecimal text (JSON and CSV have no bytes)."""
-    blobs = [c for c in frame.columns if frame[c].dtype == object and frame[c].map(type).eq(bytes).any()]
+    blobs = [k for k in range(frame.shape[1]) if frame.dtypes.iloc[k] == object
+             and frame.iloc[:, k].map(type).eq(bytes).any()]
     if not blobs:
         return frame
     frame = frame.copy()
-    for column in blobs:
-        frame[column] = frame[column].map(lambda v: v.hex() if isinstance(v, bytes) else v)
+    for k in blobs:
+        frame.isetitem(k, frame.iloc[:, k].map(lambda v: v.hex() if isinstance(v, bytes) else v))
     return frame
 
 
@@ -236,9 +241,76 @@ def run_events(args):
 
 
 def run_sql(args):
-    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2."""
-    return _query(args, "sql", None, args.query, time_limit=args.time_limit, max_rows=args.max_rows,
-                  memory_limit_mib=args.memory_limit)
+    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2.
+
+    The table format shows the result as one bounded table (:func:`stickslip.provenance.query.sql`); CSV and
+    JSON are streamed (:func:`stickslip.provenance.query.sql_pieces`): every row is written as it is fetched,
+    never a table of the whole result, and the time limit covers the writing.
+    """
+    bounds = {"time_limit": args.time_limit, "max_rows": args.max_rows, "memory_limit_mib": args.memory_limit}
+    if args.format == "table":
+        return _query(args, "sql", None, args.query, **bounds)
+    written = 0
+    try:
+        with query.sql_pieces(args.query, _database(args), **bounds) as pieces:
+            for rows in streamed_text(pieces, args.format):
+                written += rows
+    except query.QueryError as error:
+        kept = f" (the output holds the {written} rows before it)" if written else ""
+        print(f"stickslip: error: {error}{kept}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # `stickslip db sql ... | head`: the reader stopped, not an error
+        sys.stdout = open(os.devnull, "w")
+    return 0
+
+
+def streamed_text(pieces, fmt):
+    """Write the rows of a query to stdout as CSV or JSON, piece by piece; yield the rows of each piece written.
+
+    Values as SQLite gives them, a blob as its hexadecimal text; the columns of the vocabulary that are booleans
+    (``multi``, ``git_dirty``, ...) as true and false (CSV: ``True``, ``False``, as pandas writes them); NULL as
+    an empty field (CSV) or ``null`` (JSON, also for a non-finite number).
+    """
+    convert = [_value_converter(name) for name in pieces.columns]
+    if fmt == "csv":
+        writer = csv.writer(sys.stdout, lineterminator="\n")
+        writer.writerow(pieces.columns)
+    else:
+        sys.stdout.write("[")
+    written = 0
+    for piece in pieces:
+        rows = [[c(v) for c, v in zip(convert, row)] for row in piece]
+        if fmt == "csv":
+            writer.writerows([["" if v is None else v for v in row] for row in rows])
+        elif rows:
+            sys.stdout.write(",\n" if written else "\n")
+            sys.stdout.write(",\n".join(json.dumps(dict(zip(pieces.columns, map(_finite, row))), allow_nan=False)
+                                        for row in rows))
+        written += len(rows)
+        yield len(rows)
+    if fmt == "json":
+        sys.stdout.write("\n]\n" if written else "]\n")
+
+
+def _finite(value):
+    """A value for JSON, which has no infinity: a non-finite number as None."""
+    return None if isinstance(value, float) and not math.isfinite(value) else value
+
+
+def _value_converter(name):
+    """How a value of column ``name`` is written: a blob as hexadecimal text, a boolean of the vocabulary as a
+    bool (where it is 0 or 1)."""
+    found = quantity(name)
+    boolean = found is not None and found.dtype == "bool"
+
+    def convert(value):
+        if isinstance(value, bytes):
+            return value.hex()
+        if boolean and value in (0, 1) and not isinstance(value, str):
+            return bool(value)
+        return value
+
+    return convert
 
 
 def run_ingest(args):

@@ -57,10 +57,11 @@ import numpy as np
 
 from .. import __version__, formats
 from ..arithmetic import check_resume, decisive
-from ..h5io import (FileFormatError, attribute, copy_file, open_file, read_array, read_table, write_attrs,
-                    write_dataset)
+from ..h5io import (CorruptFileError, FileFormatError, attribute, copy_file, open_file, read_array, read_table,
+                    write_attrs, write_dataset)
 from ..mesh import load_mesh, save_mesh
 from ..output_safety.atomic import atomic_output
+from ..stored_rows import first_unstored_row
 
 __all__ = ["FORMAT", "HEADER", "REGIMES", "StoredState", "create_file", "append_increment", "rewrite", "read_params",
            "read_increments", "read_run_attrs", "stored_increments", "RunFile", "describe", "check_arithmetic"]
@@ -246,7 +247,7 @@ def rewrite(path, **attrs):
         Root attributes to set in the copy (e.g. ``completed``, ``stop_reason``).
     """
     with open_file(path) as source, atomic_output(path) as tmp:
-        _check(source)
+        RunFile(source)  # header, mesh, the arrays' shapes and the stored rows checked before a byte is copied
         with open_file(tmp, "w") as target:
             copy_file(source, target, rows=stored_increments(source))
             write_attrs(target, attrs)
@@ -299,12 +300,20 @@ def _check(file):
 
 
 def stored_increments(file):
-    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``).
+    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``), checked against its
+    datasets.
+
+    Every growable dataset of ``/state`` and ``/increments`` must hold ``nstored`` rows, and the file must store
+    the last of them (its chunk was written, :mod:`stickslip.stored_rows`): a file resized and told a larger
+    ``nstored`` is refused here, before any row is read, in a few lookups of each chunk index (a chunk missing
+    before the last is refused where the rows are read, :func:`stickslip.h5io.read_array`).
 
     Raises
     ------
     FileFormatError
         If ``nstored`` is not an integer >= 0, or more than the file's rows (``/state/t``).
+    stickslip.h5io.CorruptFileError
+        If a growable dataset holds fewer rows or the file does not store its row ``nstored - 1``.
     """
     nstored = attribute(file, "nstored", "int")
     times = file.get("state/t")
@@ -313,7 +322,23 @@ def stored_increments(file):
     if not 0 <= nstored <= times.shape[0]:
         raise FileFormatError(f"{file.filename}: attribute 'nstored' is {nstored}, expected 0 ... the "
                               f"{times.shape[0]} rows of /state/t")
+    growable = _growable(file) if nstored else []
+    if any(dataset.shape[0] < nstored or first_unstored_row(dataset, nstored - 1, nstored) is not None
+           for dataset in growable):
+        stored = {dataset.name: min(dataset.shape[0], first_unstored_row(dataset, 0, nstored) or nstored)
+                  for dataset in growable}
+        name = min(stored, key=stored.get)
+        raise CorruptFileError(f"{file.filename}: attribute 'nstored' is {nstored}, but {name} stores {stored[name]} "
+                               f"rows at most (declared: {file[name].shape[0]}): the file is damaged or not what it "
+                               "claims; remake it (rerun the job that wrote it)")
     return nstored
+
+
+def _growable(file):
+    """The datasets of ``/state`` and ``/increments`` with an unlimited first axis (one row per increment)."""
+    groups = [file.get(name) for name in ("state", "increments")]
+    return [item for group in groups if isinstance(group, h5py.Group) for item in group.values()
+            if isinstance(item, h5py.Dataset) and item.maxshape and item.maxshape[0] is None]
 
 
 def read_params(file):
@@ -366,6 +391,25 @@ class RunFile:
         self.params = read_params(file)
         self.mesh = load_mesh(file["mesh"])
         self.nstored = stored_increments(file)
+        self._check_shapes()
+
+    def _check_shapes(self):
+        """Raise FileFormatError unless the linear response and the state have the shapes of the mesh (module
+        docstring), before any of them is used."""
+        ndof, nlayer = self.mesh.ndof, self.mesh.nlayer
+        expected = {"event/delta_u": (ndof,), "event/delta_eps": (self.mesh.N * self.mesh.n_interfaces, 4, 3),
+                    "event/delta_target": (nlayer,), "event/delta_lever": (1,), "state/u": (ndof,),
+                    "state/target": (nlayer,), "state/lever_target": (), "state/t": ()}
+        for name, shape in expected.items():
+            dataset = self.file.get(name)
+            per_row = name.startswith("state/")
+            found = dataset.shape if isinstance(dataset, h5py.Dataset) else None
+            found = (found[1:] if found else None) if per_row else found
+            if found != shape:
+                what = f"of shape {dataset.shape}" if isinstance(dataset, h5py.Dataset) else "missing"
+                raise FileFormatError(f"{self.file.filename}: /{name} is {what}, expected "
+                                      f"{'rows of ' if per_row else ''}{shape} (the stored mesh's): the file is "
+                                      "damaged")
 
     def state(self, increment):
         """The :class:`StoredState` of a stored increment (its ``further`` empty in a file without further state)."""

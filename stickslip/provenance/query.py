@@ -44,7 +44,8 @@ from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
 
 __all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S", "MAX_ROWS",
-           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "check_bounds"]
+           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "sql_pieces", "Pieces",
+           "unique_names", "check_bounds"]
 
 #: Where the workflow writes the database of the default study (relative to the workflow directory);
 #: a study named S has ``results/S/stickslip.sqlite``.
@@ -197,10 +198,16 @@ class _Bounds:
             if self.stop == "interrupt":
                 raise KeyboardInterrupt
 
-    def take(self, piece):
-        """Count a piece of fetched rows; raise QueryError past a bound (rows, bytes, time)."""
+    def take(self, piece, columns, kept=True):
+        """Count a piece of fetched rows; raise QueryError past a bound (rows, bytes, time).
+
+        ``kept``: the rows stay in memory until the query ends and a table of ``columns`` is made of them (their
+        bytes add up, with 16 bytes a value for the table); else only the piece is held (a stream: it is
+        bounded alone).
+        """
         self.rows += len(piece)
-        self.bytes += _row_bytes(piece)
+        held = _row_bytes(piece) + (16 * len(piece) * len(columns) if kept else 0)
+        self.bytes = self.bytes + held if kept else held
         if self.max_rows is not None and self.rows > self.max_rows:
             raise QueryError(f"the query returns more than {self.max_rows} rows (the bound on rows: add LIMIT, or "
                              f"raise it with `db sql --max-rows N`, max_rows= in Python)")
@@ -232,27 +239,56 @@ def _row_bytes(rows):
     return sum(map(sys.getsizeof, values)) + sum(map(sys.getsizeof, rows))
 
 
-def _rows(connection, statement, bounds):
-    """The rows of ``statement`` as a DataFrame, fetched in pieces that the bounds count (:meth:`_Bounds.take`).
+def unique_names(names):
+    """Column names made unique: a name seen before gets ``.1``, ``.2``, ... (as :func:`pandas.read_csv` does).
+
+    Parameters
+    ----------
+    names : Iterable[str]
+
+    Returns
+    -------
+    list[str]
+    """
+    seen, out = set(), []
+    for name in map(str, names):
+        unique, k = name, 0
+        while unique in seen:
+            k += 1
+            unique = f"{name}.{k}"
+        seen.add(unique)
+        out.append(unique)
+    return out
+
+
+class Pieces:
+    """The rows of a running query, fetched in pieces that its bounds count (:meth:`_Bounds.take`).
 
     A piece holds up to :data:`_FETCH` rows and about :data:`_PIECE_BYTES`: rows of large values (blobs) are
-    fetched a few at a time, so that no piece passes the memory bound by much.
+    fetched a few at a time, so that no piece passes the memory bound by much. The time between two pieces
+    (what the reader does with one) counts against the time limit.
+
+    Attributes
+    ----------
+    columns : list[str]
+        The result's column names, made unique (:func:`unique_names`).
     """
-    result = connection.execute(statement)
-    columns = list(result.keys())
-    rows, size = [], 16
-    while True:
-        piece = result.fetchmany(size)
-        try:
-            bounds.take(piece)
-        except BaseException:
-            result.close()
-            raise
-        rows += piece
-        if len(piece) < size:
-            return pd.DataFrame.from_records(rows, columns=columns, coerce_float=True)
-        row_bytes = max(1, _row_bytes(piece) // len(piece))
-        size = int(min(_FETCH, max(1, _PIECE_BYTES // row_bytes)))
+
+    def __init__(self, result, bounds, kept):
+        self._result, self._bounds, self._kept = result, bounds, kept
+        self.columns = unique_names(result.keys())
+
+    def __iter__(self):
+        """Lists of row tuples, in order; the last may be empty."""
+        size = 16
+        while True:
+            piece = self._result.fetchmany(size)
+            self._bounds.take(piece, self.columns, self._kept)
+            yield piece
+            if len(piece) < size:
+                return
+            row_bytes = max(1, _row_bytes(piece) // len(piece))
+            size = int(min(_FETCH, max(1, _PIECE_BYTES // row_bytes)))
 
 
 def check_bounds(time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS, memory_limit_mib=MEMORY_LIMIT_MIB):
@@ -277,7 +313,13 @@ def check_bounds(time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS, memory_limit_mib=ME
             number("memory_limit_mib", "--memory-limit MIB", memory_limit_mib))
 
 
-def _frame(database, statement, only_reading=False, time_limit=None, max_rows=None, memory_limit_mib=None):
+@contextmanager
+def _pieces(database, statement, only_reading=False, time_limit=None, max_rows=None, memory_limit_mib=None, kept=True):
+    """Run ``statement`` under the bounds; the block reads its rows from the :class:`Pieces` it is given.
+
+    Every failure of the query, its bounds included, also while the block reads the rows, ends as one
+    :class:`QueryError` naming the database (Ctrl-C as KeyboardInterrupt).
+    """
     engine = _engine(database)
     bounds = _Bounds(time_limit, max_rows, memory_limit_mib)
     try:
@@ -288,7 +330,11 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
                 if only_reading:
                     driver.set_authorizer(_only_reading)
                 try:
-                    frame = _rows(connection, statement, bounds)
+                    result = connection.execute(statement)
+                    try:
+                        yield Pieces(result, bounds, kept)
+                    finally:
+                        result.close()
                 finally:
                     driver.set_authorizer(None)
     except _Stopped:
@@ -299,6 +345,8 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
         raise QueryError(f"{database}: the statement returns no rows; `db sql` runs queries (SELECT)") from None
     except QueryError as error:
         raise QueryError(f"{database}: {error}") from None
+    except UnicodeDecodeError as error:  # SQLite keeps no checksums: a flipped bit in a text value
+        raise _damaged(database, f"{error.reason} at byte {error.start}") from None
     except MemoryError:  # SQLITE_NOMEM at the heap limit, or the machine's memory
         if not _HEAP.exhausted(bounds.memory):
             raise QueryError(f"{database}: the machine ran out of memory during the query, after {bounds.rows} rows "
@@ -310,11 +358,26 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
         bound = bounds.error(database, cause)
         if bound is not None:
             raise bound from None
+        if "decode to UTF-8" in str(cause):  # a text value of a column the driver decodes itself
+            raise _damaged(database, str(cause).split(" with text ")[0]) from None
         if "authoriz" in str(cause):  # "not authorized", "authorization denied"
             cause = f"refused ({cause}): `db sql` only reads (SELECT, WITH, PRAGMA {', '.join(READ_ONLY_PRAGMAS)})"
         raise QueryError(f"{database}: query failed: {cause}") from None
     finally:
         engine.dispose()
+
+
+def _damaged(database, detail):
+    """The QueryError of a text value that is not UTF-8 (SQLite keeps no checksums: a flipped bit in a value)."""
+    return QueryError(f"{database}: a text value is not UTF-8 ({detail}): the database is damaged; `stickslip db "
+                      "rebuild` remakes it from the provenance records")
+
+
+def _frame(database, statement, **bounds):
+    """The rows of ``statement`` as one typed DataFrame, the rows and the table counted by the bounds."""
+    with _pieces(database, statement, **bounds) as pieces:
+        rows = [row for piece in pieces for row in piece]
+        frame = pd.DataFrame.from_records(rows, columns=pieces.columns, coerce_float=True)
     return typed(frame)
 
 
@@ -482,6 +545,14 @@ def figures(database=DEFAULT_DATABASE):
     return _units(_frame(database, statement))
 
 
+def _checked_query(query, database, time_limit, max_rows, memory_limit_mib):
+    """The bounds of :func:`sql` checked (:func:`check_bounds`), and the query not empty."""
+    bounds = check_bounds(time_limit, max_rows, memory_limit_mib)
+    if not isinstance(query, str) or not query.strip():
+        raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
+    return dict(zip(("time_limit", "max_rows", "memory_limit_mib"), bounds))
+
+
 def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS,
         memory_limit_mib=MEMORY_LIMIT_MIB):
     """Run one SQL query on a read-only connection and return the result.
@@ -501,14 +572,15 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     max_rows : int or None
         Refuse a result of more rows; None or 0: no limit.
     memory_limit_mib : float or None
-        Memory [MiB] of SQLite (heap, temporary tables and sorts included), and of the rows fetched
-        (the table built from them takes up to as much again); None or 0: no limit.
+        Memory [MiB] of SQLite (heap, temporary tables and sorts included), and of the result: the rows
+        fetched and the table made of them (16 bytes a value), counted as they come; None or 0: no limit.
 
     Returns
     -------
     pandas.DataFrame
-        Columns named as the vocabulary's in their dtype (:func:`stickslip.vocabulary.typed`: ``multi`` a
-        bool, ``started_at`` a datetime, ...); ``attrs["units"]`` gives their units (None for the others).
+        Columns named as the query names them, a name repeated made unique (``x``, ``x.1``: :func:`unique_names`),
+        those of the vocabulary in their dtype (:func:`stickslip.vocabulary.typed`: ``multi`` a bool,
+        ``started_at`` a datetime, ...); ``attrs["units"]`` gives their units (None for the others).
 
     Raises
     ------
@@ -522,8 +594,33 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     -----
     Cost: whatever the query costs, within the bounds; the indexes are listed in docs/database.md.
     """
-    time_limit, max_rows, memory_limit_mib = check_bounds(time_limit, max_rows, memory_limit_mib)
-    if not isinstance(query, str) or not query.strip():
-        raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
-    return _units(_frame(database, text(query), only_reading=True, time_limit=time_limit, max_rows=max_rows,
-                         memory_limit_mib=memory_limit_mib))
+    bounds = _checked_query(query, database, time_limit, max_rows, memory_limit_mib)
+    return _units(_frame(database, text(query), only_reading=True, **bounds))
+
+
+@contextmanager
+def sql_pieces(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS,
+               memory_limit_mib=MEMORY_LIMIT_MIB):
+    """Run one SQL query as :func:`sql` does, and stream its rows: the block reads them from the :class:`Pieces`.
+
+    What the block does with a piece (formats it, writes it) counts against the time limit; memory is bounded
+    for SQLite and for each piece, which is all that is held (``stickslip db sql --format csv|json``).
+
+    Parameters
+    ----------
+    query, database, time_limit, max_rows, memory_limit_mib
+        As :func:`sql`.
+
+    Yields
+    ------
+    Pieces
+        ``columns``, and lists of row tuples (values as SQLite gives them: int, float, str, bytes, None).
+
+    Raises
+    ------
+    QueryError
+        As :func:`sql`, also while the block reads (a bound reached after some rows were handed out).
+    """
+    bounds = _checked_query(query, database, time_limit, max_rows, memory_limit_mib)
+    with _pieces(database, text(query), only_reading=True, kept=False, **bounds) as pieces:
+        yield pieces

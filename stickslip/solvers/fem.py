@@ -14,6 +14,7 @@ backend by name (:data:`CHOICES`): its code hash covers those two and no other
 from .. import registry
 from ..fem.backends import BACKENDS, make_backend
 from ..fem.laws import INTERFACE_LAWS
+from ..fem.memory import check_run_memory
 from ..fem.parameters import FemParams
 from ..fem.replay import EventReplay
 from ..fem.run import simulate_to_file
@@ -55,7 +56,9 @@ def stack_mesh(params, inputs):
 
 
 def can_run(params):
-    """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)."""
+    """Raise :class:`stickslip.plugin_params.ParameterError` if this machine cannot run ``params.backend`` (e.g. no GPU)
+    or has less memory than the run needs (:func:`stickslip.fem.memory.check_run_memory`)."""
+    check_run_memory(params)
     make_backend(params.backend)
 
 
