@@ -4,6 +4,10 @@ The parameters are validated with the plugin's dataclass (the message names the 
 was expected), the output is checked writable before any work, and an existing output is claimed
 by the one rule of every command that writes a file (:func:`stickslip.output_safety.overwrite.claimed_output`):
 the same run is resumed (``fem``) or written again, another run is refused unless ``overwrite``.
+A run that succeeds gets its provenance record beside it (``<stem>.provenance.json``,
+:mod:`stickslip.provenance.record`: run id, plugin, code hash, commit, parameters, host, times, the output's
+sha256), as a workflow job's: the run object's ``run_id`` and ``provenance``, and what
+:meth:`stickslip.study_results.StudyResults.add` puts into a study.
 """
 
 import numbers
@@ -15,6 +19,8 @@ from .numba_options import set_num_threads
 from .output_safety.atomic import check_output
 from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
 from .plugin_params import ParameterError, params_to_dict, parse_params
+from .provenance.code import code_hash
+from .provenance.record import record_path, recording
 
 __all__ = ["run_identity", "run_solver"]
 
@@ -47,7 +53,9 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     Returns
     -------
     registry.Plugin, object
-        The solver and its validated parameters.
+        The solver and its validated parameters. The output's provenance record is written beside it
+        (:func:`stickslip.provenance.record.record_path`; the times, wall time and memory are this call's: a
+        resumed run's, or nothing but the check of a completed one).
 
     Raises
     ------
@@ -70,6 +78,11 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
         plugin.preflight(params)
     used = set_num_threads(threads)
     check_output(output)
+    record = record_path(output)
     with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint):
-        plugin.run(params, output, threads=used, inputs={})
+        record.unlink(missing_ok=True)  # an earlier call's: the record is written again when this one succeeds
+        with recording(record, [("output", output, plugin.produces)], run_id=registry.run_id(plugin, params),
+                       kind="solver", plugin=plugin.name, plugin_version=plugin.version,
+                       code_hash=code_hash(plugin.module), params=params_to_dict(params), threads=used):
+            plugin.run(params, output, threads=used, inputs={})
     return plugin, params
