@@ -358,7 +358,8 @@ class UnitFrame(pd.DataFrame):
     Every table of the package's API is one. pandas keeps ``attrs`` through an operation on one table, and drops
     them in a ``merge``, ``join`` or ``concat`` of tables whose ``attrs`` differ; here each column of the result
     keeps the unit of the column it came from (:func:`_column_units`), so ``runs.merge(events, ...)`` and
-    ``pd.concat([fem_events, lab_events])`` carry the units of all their columns. The data and dtypes are pandas'
+    ``pd.concat([fem_events, lab_events])`` carry the units of all their columns, and a renamed column keeps its
+    unit. The data and dtypes are pandas'
     own (plain float64, Int64, ...): no unit-aware arithmetic (pint-pandas) and no other array library (xarray).
     The result of a merge or concat is a ``UnitFrame`` where the left or first table is one.
     """
@@ -376,6 +377,24 @@ class UnitFrame(pd.DataFrame):
         if any("units" in obj.attrs for obj in inputs):
             self.attrs["units"] = _column_units(self.columns, inputs, method)
         return self
+
+    def __setitem__(self, key, value):
+        """pandas' ``frame[key] = value``; a new column gets the vocabulary's unit of its name (None if unknown)."""
+        super().__setitem__(key, value)
+        units = self.attrs.get("units")
+        if units is not None:
+            for name in map(str, self.columns):
+                units.setdefault(name, unit(name))
+
+    def rename(self, *args, **kwargs):
+        """pandas' ``rename``; a renamed column keeps its unit."""
+        columns, units = list(self.columns), dict(self.attrs.get("units", {}))
+        result = super().rename(*args, **kwargs)
+        renamed = self if result is None else result  # inplace=True
+        if units and len(renamed.columns) == len(columns):
+            renamed.attrs["units"] = {str(new): units.get(str(old), unit(new))
+                                      for old, new in zip(columns, renamed.columns)}
+        return result
 
 
 def with_units(frame, extra=None):

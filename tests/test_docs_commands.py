@@ -52,3 +52,12 @@ def test_documented_command_parses(document, tokens):
     if args.command == "simulate":
         plugin = registry.get("solver", args.solver)
         parse_params(plugin.params, parse_assignments(args.param), owner=f"solver '{plugin.name}'")
+
+
+def test_the_readmes_examples_write_different_files():
+    """The README's Python example and its commands can run one after the other: no two write one file."""
+    text = (ROOT / "README.md").read_text()
+    outputs = [tokens[tokens.index("-o") + 1] for name, tokens in COMMANDS
+               if name == "README.md" and tokens[1] == "simulate"]
+    outputs += re.findall(r'stickslip\.simulate\("[^"]+", "([^"]+)"', text)
+    assert len(outputs) >= 4 and len(outputs) == len(set(outputs)), outputs
