@@ -481,16 +481,8 @@ def missing_as_na(frame):
     A column with missing values takes pandas' nullable dtype (``Float64``, ``Int64``, ``boolean``; text:
     ``string``), whose missing value is ``pd.NA`` (``pd.isna``; ``to_numpy()`` gives NaN in a float array);
     other columns (lists, mixed values) keep their dtype with ``pd.NA`` for ``None`` and NaN; datetimes keep
-    ``NaT``, pandas' missing datetime. Columns without missing values are left as they are.
-
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        Changed in place and returned.
-
-    Returns
-    -------
-    pandas.DataFrame
+    ``NaT``, pandas' missing datetime. Columns without missing values are left as they are. ``frame`` (a
+    pandas DataFrame) is changed in place and returned.
     """
     for column in frame.columns:
         values = frame[column]

@@ -132,3 +132,20 @@ def test_a_simulated_run_carries_its_id_and_provenance_and_joins_the_study(study
     shutil.copyfile(run.path, copy)
     with pytest.raises(FileFormatError, match="no provenance record"):
         study.add(stickslip.open_run(copy))
+
+
+def test_a_study_config_with_the_old_name_is_mapped_with_a_warning():
+    import jsonschema
+    import yaml
+
+    from stickslip.study_plan import Study, normalise, plugin_sections
+
+    config = yaml.safe_load("study: old\nsolvers:\n  lever:\n    - params: {protocol: individual, n: 1}\n"
+                            "      grid: {a: [1, 2]}\nanalyses: {}\nfigures: {}\n")
+    normalise(config)
+    for _, section, schema in plugin_sections(config):
+        jsonschema.validate(section, schema)  # the schema of the config accepts the old name (no default filled)
+    with pytest.warns(RenamedParameterWarning, match="'a' of solver 'lever' is called 'driven_slab'"):
+        study = Study(config, ["old.yaml"])
+    assert sorted(sim.params["driven_slab"] for sim in study.simulations) == [1, 2]
+    assert not any("a" in sim.params for sim in study.simulations)
