@@ -178,3 +178,20 @@ def test_every_link_resolves_and_nothing_can_write(browser, served):
     assert len(seen) > 20  # the index, every figure's and every run's page
     assert _status(url + "index.html", "POST") == 501 and _status(url + "index.html", "PUT") == 501
     assert _status(url + "../../etc/passwd") == 404
+
+
+def test_the_workflow_writes_the_pages_as_a_static_site(browser, ci_study, tmp_path):
+    """`snakemake browse` writes results/ci/browse/: the same pages, read from files (file://) without a server."""
+    folder = tmp_path / "repository"
+    shutil.copytree(ci_study, folder, symlinks=True)  # with Snakemake's metadata: only the browse rule runs
+    built = subprocess.run([sys.executable, "-m", "snakemake", "browse", "--cores", "1", "--configfile",
+                            "workflow/config/ci.yaml"], cwd=folder, capture_output=True, text=True)
+    assert built.returncode == 0, built.stderr[-3000:]
+    assert "rule browse:" in built.stdout + built.stderr and "rule database:" not in built.stdout + built.stderr
+    index = folder / "results" / "ci" / "browse" / "index.html"
+    visit = Visit(browser)
+    visit.open(index.as_uri())
+    assert visit.page.locator("#runs-table tbody tr").count() == len(stickslip.study("ci", workdir=folder).runs())
+    visit.page.locator("ul.figures a").first.click()
+    visit.check()
+    visit.shot(tmp_path, "static-figure")
