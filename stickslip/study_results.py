@@ -22,8 +22,8 @@ from .errors import RunNotFoundError, StudyNotFoundError
 from .h5io import FileFormatError
 from .hashing import sha256_file
 from .output_safety.atomic import atomic_output
-from .provenance import query
 from .plugin_params import ParameterError
+from .provenance import query
 from .provenance.filters import EVENT_FILTERS, RUN_FILTERS, with_filters
 from .provenance.record import record_path, write_record
 from .runs import open_run

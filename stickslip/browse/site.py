@@ -97,10 +97,7 @@ def _plugin_units(kind, plugin):
 def _plot_run(run, output):
     """Plot a simulation's increments (fem: the stack's stress against its strain; a recording: the lever's force and
     the slabs' positions against time) into ``output`` (PNG). Returns the caption."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # drawn without pyplot: no backend chosen, no window
 
     figure = Figure(figsize=(7, 3.2), dpi=90, layout="constrained")
     if run.format == "fem-run":
