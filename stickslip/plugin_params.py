@@ -15,6 +15,10 @@ Supported field types: ``int``, ``float``, ``bool``, ``str`` and tuples
 A dataclass may define ``check(self)``, called after the per-field checks, for
 conditions that involve several fields; it raises :class:`ParameterError`.
 
+A parameter renamed keeps its old name as an alias: the dataclass's ``RENAMED`` (a ``ClassVar``, old name -> new
+name) maps a value given under the old name to the new one, with a :class:`RenamedParameterWarning` (the config's
+schema accepts it too); a value given under both names is refused.
+
 A field added to a plugin after runs were made is declared with ``extension=True``:
 while it has its default it is left out of :func:`params_to_dict`, so the run ids,
 stored parameters and files of the runs made before it keep their bytes (its default
@@ -29,11 +33,13 @@ import dataclasses
 import difflib
 import math
 import typing
+import warnings
 from collections.abc import Iterable, Mapping
 
 __all__ = [
     "ParameterError",
     "ParameterWarning",
+    "RenamedParameterWarning",
     "param",
     "parse_params",
     "parse_value",
@@ -52,6 +58,27 @@ class ParameterError(ValueError):
 
 class ParameterWarning(UserWarning):
     """Parameters that the method represents but outside the regime where it was studied; the message says which."""
+
+
+class RenamedParameterWarning(ParameterWarning, FutureWarning):
+    """A parameter given under its old name (a dataclass's ``RENAMED``): it is mapped to the new one.
+
+    A ``FutureWarning``: shown by default, as Python shows warnings meant for the users of a package.
+    """
+
+
+def _renamed(cls, values, owner):
+    """``values`` (a dict, changed in place) with every old name of ``cls.RENAMED`` replaced by its new one."""
+    for old, new in getattr(cls, "RENAMED", {}).items():
+        if old not in values:
+            continue
+        where = f" of {owner}" if owner else ""
+        if new in values:
+            raise ParameterError(f"parameter '{old}'{where} is '{new}' now; give '{new}' alone")
+        warnings.warn(f"parameter '{old}'{where} is called '{new}' now (the old name is mapped, and will go)",
+                      RenamedParameterWarning, stacklevel=4)
+        values[new] = values.pop(old)
+    return values
 
 
 def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, exclusive_minimum=None,
@@ -202,7 +229,7 @@ def parse_params(cls, values=None, *, owner=""):
         wrong type or out of range (the message names the field and the expectation),
         or a failed ``check()``.
     """
-    values = dict(values or {})
+    values = _renamed(cls, dict(values or {}), owner)
     types = _field_types(cls)
     unknown = sorted(set(values) - set(types))
     if unknown:
@@ -244,6 +271,7 @@ def parse_value(cls, name, value, *, owner=""):
     ParameterError
         If ``cls`` has no such field, or the value does not fit it.
     """
+    name = next(iter(_renamed(cls, {name: value}, owner)))
     types = _field_types(cls)
     if name not in types:
         where = f" of {owner}" if owner else ""
@@ -351,6 +379,9 @@ def json_schema(cls):
         unit = f" [{meta['unit']}]" if meta.get("unit") else ""
         prop["description"] = meta.get("doc", "") + unit
         properties[f.name] = prop
+    for old, new in getattr(cls, "RENAMED", {}).items():  # accepted, mapped by parse_params; no default to fill in
+        properties[old] = {**{k: v for k, v in properties[new].items() if k != "default"}, "deprecated": True,
+                           "description": f"the old name of {new}"}
     return {"type": "object", "properties": properties, "additionalProperties": False}
 
 

@@ -4,6 +4,10 @@ The parameters are validated with the plugin's dataclass (the message names the 
 was expected), the output is checked writable before any work, and an existing output is claimed
 by the one rule of every command that writes a file (:func:`stickslip.output_safety.overwrite.claimed_output`):
 the same run is resumed (``fem``) or written again, another run is refused unless ``overwrite``.
+A run that succeeds gets its provenance record beside it (``<stem>.provenance.json``,
+:mod:`stickslip.provenance.record`: run id, plugin, code hash, commit, parameters, host, times, the output's
+sha256), as a workflow job's: the run object's ``run_id`` and ``provenance``, and what
+:meth:`stickslip.study_results.StudyResults.add` puts into a study.
 """
 
 import numbers
@@ -17,6 +21,8 @@ from .numba_options import set_num_threads
 from .output_safety.atomic import check_output
 from .output_safety.overwrite import OVERWRITE_HINT, claimed_output
 from .plugin_params import ParameterError, ParameterWarning, params_to_dict, parse_params
+from .provenance.code import plugin_code_hash
+from .provenance.record import record_path, recording
 
 __all__ = ["run_identity", "run_solver", "invalid_params"]
 
@@ -76,7 +82,9 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     Returns
     -------
     registry.Plugin, object
-        The solver and its validated parameters.
+        The solver and its validated parameters. The output's provenance record is written beside it
+        (:func:`stickslip.provenance.record.record_path`; the times, wall time and memory are this call's: a
+        resumed run's, or nothing but the check of a completed one).
 
     Raises
     ------
@@ -102,10 +110,15 @@ def run_solver(solver, output, values, *, threads=1, overwrite=False, overwrite_
     if plugin.preflight is not None:
         plugin.preflight(params)
     used = set_num_threads(threads)
+    record = record_path(output)
     with claimed_output(output, run_identity(plugin, params), overwrite=overwrite, hint=overwrite_hint,
                         damage=lambda stored: invalid_params(plugin, stored)):
-        try:
-            plugin.run(params, output, threads=used, inputs={})
-        except SolverError as error:
-            raise SolverError(f"{output}: solver '{plugin.name}' cannot make this run: {error}") from None
+        record.unlink(missing_ok=True)  # an earlier call's: the record is written again when this one succeeds
+        with recording(record, [("output", output, plugin.produces)], run_id=registry.run_id(plugin, params),
+                       kind="solver", plugin=plugin.name, plugin_version=plugin.version,
+                       code_hash=plugin_code_hash(plugin, params), params=params_to_dict(params), threads=used):
+            try:
+                plugin.run(params, output, threads=used, inputs={})
+            except SolverError as error:
+                raise SolverError(f"{output}: solver '{plugin.name}' cannot make this run: {error}") from None
     return plugin, params

@@ -58,6 +58,7 @@ PATHS = {
     "events": "events/{analysis}/{solver}/{run_id}.h5",
     "figure": "figures/{figure}.pdf",
     "database": "stickslip.sqlite",
+    "added": "added/{solver}/{run_id}.h5",
     "logs": "logs",
     "benchmark": "logs/benchmarks/sim/{solver}/{run_id}.tsv",
 }
@@ -559,6 +560,12 @@ class Study:
         paths += [job.path for job in self.analysis_jobs]
         paths += [job.path for job in self.figures.values()]
         return sorted(record_path(p).as_posix() for p in paths)
+
+    def added_records(self):
+        """The records of the simulations added to the study (:meth:`stickslip.study_results.StudyResults.add`),
+        sorted: the database rule ingests them too."""
+        return sorted(path.as_posix() for path in Path(self.root).glob(PATHS["added"].format(solver="*", run_id="*")
+                                                                          .replace(".h5", ".provenance.json")))
 
     @staticmethod
     def code(kind, name):

@@ -46,7 +46,7 @@ from .provenance.record import read_record, recording
 from .termination import interrupts_raised
 
 __all__ = ["prepare_environment", "partial_path", "kept_record", "run_mesh", "run_simulation", "run_analysis",
-           "run_figure", "build_database", "release_completed"]
+           "run_figure", "build_database", "build_browse", "release_completed"]
 
 #: What a job says about an existing output of another run (jobs have no ``--overwrite``).
 _NOT_THIS_JOBS = "it is not this job's output: move it away (or delete it) and rerun"
@@ -476,3 +476,21 @@ def build_database(records, database, log):
 
         counts = ingest(database, records, rebuild=True)
         print("ingested " + ", ".join(f"{count} {name}" for name, count in counts.items()))
+
+
+def build_browse(study, output, log):
+    """Write a study's pages as a static site (the browse rule; :func:`stickslip.browse.site.build_site`).
+
+    Parameters
+    ----------
+    study : str
+        The study's name (its results tree ``results/{study}`` in the working directory, the workflow's).
+    output : str or pathlib.Path
+        The site's folder.
+    log : str or pathlib.Path
+    """
+    with _logged(log):
+        from .browse.site import build_site  # matplotlib and the database layer: for this job only
+        from .study_results import StudyResults
+
+        print(build_site(StudyResults(study, workdir="."), output, progress=print))

@@ -8,6 +8,7 @@ import subprocess
 import sys
 import time
 from contextlib import redirect_stdout
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -46,6 +47,21 @@ def test_db_commands(toy_results, capsys):
     assert status == 2 and "only reads" in capsys.readouterr().err
     status, _ = _run("db", "runs", "--db", "nowhere.sqlite")
     assert status == 2 and "nowhere.sqlite: no such database" in capsys.readouterr().err
+
+
+def test_db_options_before_or_after_the_sub_command(toy_results, tmp_path, monkeypatch):
+    """``--workdir``, ``--study`` and ``--db`` work before the sub-command (``db --workdir DIR runs``) and after it,
+    and after it they win."""
+    _run("db", "rebuild")
+    workflow = Path.cwd()
+    (workflow / "Snakefile").write_text("")
+    monkeypatch.chdir(tmp_path)  # no Snakefile at or above
+    after = _run("db", "runs", "--workdir", str(workflow), "--format", "csv")
+    before = _run("db", "--workdir", str(workflow), "runs", "--format", "csv")
+    assert after == before and after[0] == 0 and len(pd.read_csv(io.StringIO(after[1]))) == 5
+    assert _run("db", "--workdir", str(tmp_path), "runs", "--workdir", str(workflow), "--format", "csv") == after
+    assert _run("db", "--study", "default", "--workdir", str(workflow), "events", "--seed", "2")[0] == 0
+    assert _run("db", "--db", str(workflow / "results" / "default" / "stickslip.sqlite"), "runs")[0] == 0
 
 
 def test_db_sql_only_reads(toy_results, capsys, tmp_path):

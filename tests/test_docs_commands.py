@@ -137,3 +137,12 @@ def test_the_plugin_package_of_the_docs_runs_a_study_and_reruns_what_its_law_cha
     assert line in law.read_text()
     law.write_text(law.read_text().replace(line, line[:-1] + "  # x: from the well's centre\n"))
     assert planned() == {"simulate": 1, "events": 2, "figure_figS_largest": 1, "database": 1, "all": 1}
+
+
+def test_the_readmes_examples_write_different_files():
+    """The README's Python example and its commands can run one after the other: no two write one file."""
+    text = (ROOT / "README.md").read_text()
+    outputs = [tokens[tokens.index("-o") + 1] for name, tokens in COMMANDS
+               if name == "README.md" and tokens[1] == "simulate"]
+    outputs += re.findall(r'stickslip\.simulate\("[^"]+", "([^"]+)"', text)
+    assert len(outputs) >= 4 and len(outputs) == len(set(outputs)), outputs

@@ -28,7 +28,7 @@ from ..termination import exit_status, interrupts_raised, interruption
 __all__ = ["main", "COMMANDS", "add_overwrite_option"]
 
 #: Sub-command modules, in the order of ``stickslip --help``.
-COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db")
+COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db", "browse")
 
 #: Errors of the user's making, printed as one line (exit 2): a bad parameter, plugin, file or output, and a run
 #: that the parameters ask for but the solver cannot make (:class:`stickslip.errors.SolverError`).
@@ -48,6 +48,7 @@ EPILOG = ("examples:\n"
           "  stickslip import-csv --force F.csv --positions X.csv --n 3 -o lab.h5\n"
           "  stickslip analyze-experiment lab.h5 -o slips.csv --aging\n"
           "  stickslip db events --regime stiff               slip events of the study's database\n"
+          "  stickslip browse --study ci                      the study in the browser, read only\n"
           "`stickslip COMMAND --help` describes each command; README.md and docs/ the study.")
 
 

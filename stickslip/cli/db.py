@@ -39,9 +39,8 @@ DESCRIPTION = ("Query and (re)build the results database of a study: results/STU
                "workflow directory (the nearest folder with a Snakefile at or above the current one, or "
                f"--workdir, or ${ENVIRONMENT}).")
 
-#: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
-RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "driven_slab", "blocks", "phi",
-               "regime", "temperature", "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
+#: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column): the API's narrow ``runs()``.
+RUN_COLUMNS = query.RUN_COLUMNS
 
 EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",
                  "interface", "slip", "dmu", "dmu_sig0", "multi", "time", "t", "increment")
@@ -56,14 +55,19 @@ def _study(name):
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
-def _database_options(parser):
-    parser.add_argument("--study", default="default", type=_study,
+def _database_options(parser, defaults=True):
+    """``--study``, ``--workdir``, ``--db``: on ``db`` (with their defaults) and on each of its sub-commands, where
+    they default to what was given before the sub-command (``db --workdir DIR runs`` and ``db runs --workdir DIR``)."""
+    def default(value):
+        return value if defaults else argparse.SUPPRESS
+
+    parser.add_argument("--study", default=default("default"), type=_study,
                         help="study whose database to use: results/STUDY/stickslip.sqlite in the workflow directory "
                              "(default: default)")
-    parser.add_argument("--workdir", type=Path, default=None, metavar="DIR",
+    parser.add_argument("--workdir", type=Path, default=default(None), metavar="DIR",
                         help=f"the workflow directory (default: ${ENVIRONMENT}, else the nearest folder at or above "
                              "the current one with a Snakefile)")
-    parser.add_argument("--db", type=Path, default=None, help="database file (overrides --study)")
+    parser.add_argument("--db", type=Path, default=default(None), help="database file (overrides --study)")
 
 
 def _results(args):
@@ -120,7 +124,7 @@ def _filters(args, specs):
 
 
 def _common(parser, default_format="table"):
-    _database_options(parser)
+    _database_options(parser, defaults=False)
     parser.add_argument("--format", choices=FORMATS, default=default_format, help="output format (default table)")
     parser.add_argument("--all-columns", action="store_true", help="every column (table format shows the main ones)")
 
@@ -128,6 +132,7 @@ def _common(parser, default_format="table"):
 def add_parser(subparsers):
     """Add the ``db`` sub-command and its own sub-commands."""
     parser = subparsers.add_parser("db", help="query or rebuild the results database", description=DESCRIPTION)
+    _database_options(parser)
     commands = parser.add_subparsers(dest="db_command", required=True, metavar="DB_COMMAND")
 
     def command(name, summary):
@@ -159,17 +164,17 @@ def add_parser(subparsers):
 
     ingest = command("ingest", "add provenance records to the database (idempotent)")
     ingest.add_argument("records", nargs="+", type=Path, help="*.provenance.json files")
-    _database_options(ingest)
+    _database_options(ingest, defaults=False)
     ingest.set_defaults(func=run_ingest)
 
     rebuild = command("rebuild", "recreate the database from every record under the results")
-    _database_options(rebuild)
+    _database_options(rebuild, defaults=False)
     rebuild.add_argument("--results", type=Path, default=None,
                          help="results tree whose records to read (default results/STUDY)")
     rebuild.set_defaults(func=run_rebuild)
 
     migrate = command("migrate", "bring a database of an older schema to this one, keeping its rows")
-    _database_options(migrate)
+    _database_options(migrate, defaults=False)
     migrate.set_defaults(func=run_migrate)
 
 

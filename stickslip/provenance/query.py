@@ -39,12 +39,12 @@ from sqlalchemy import select, text
 from .. import registry
 from ..h5io import FileFormatError
 from ..plugin_params import params_to_dict, parse_value
-from ..vocabulary import dtype_matches, expand_json, quantity, typed
+from ..vocabulary import UnitFrame, dtype_matches, expand_json, missing_as_na, quantity, typed
 from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
 
-__all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S", "MAX_ROWS",
-           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "sql_pieces", "Pieces",
+__all__ = ["DEFAULT_DATABASE", "RUN_COLUMNS", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S",
+           "MAX_ROWS", "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "sql_pieces", "Pieces",
            "unique_names", "check_bounds"]
 
 #: Where the workflow writes the database of the default study (relative to the workflow directory);
@@ -386,6 +386,12 @@ SIMULATION_COLUMNS = ("solver", "source", "format", "path", "protocol", "n", "dr
                       "k_drive", "phi", "regime", "temperature", "attempt_rate", "drive_rate", "junction_strengthening",
                       "junction_glass_temperature", "junction_attempt_rate")
 
+#: The columns of the narrow form of ``runs()`` (:meth:`stickslip.study_results.StudyResults.runs`; ``stickslip db
+#: runs`` in table format): who ran, on what physics, at what cost, from which commit.
+RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "source", "protocol", "n", "driven_slab",
+               "plates", "blocks", "k_drive", "phi", "regime", "temperature", "seed", "wall_time_s", "peak_memory_mib",
+               "finished_at", "git_commit", "git_dirty")
+
 #: The tables of the filters whose values the database holds (``choices="database"``).
 _HELD = {"plugin": "runs", "solver": "simulations", "analysis": "slip_events"}
 
@@ -416,7 +422,10 @@ def _checked(database, specs, filters):
 
 
 def _units(frame):
-    """``attrs["units"]`` of a query's frame: the vocabulary's unit of every column in the vocabulary's dtype."""
+    """A query's frame as a :class:`~stickslip.vocabulary.UnitFrame`, its missing values ``pd.NA``
+    (:func:`~stickslip.vocabulary.missing_as_na`), ``attrs["units"]`` the vocabulary's unit of every column in the
+    vocabulary's dtype."""
+    frame = UnitFrame(missing_as_na(frame))
     units = {}
     for column in frame.columns:
         found = quantity(column)

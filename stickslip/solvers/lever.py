@@ -21,6 +21,7 @@ creep_total except for a slip still running at the end).
 """
 
 import dataclasses
+import typing
 
 import numpy as np
 
@@ -43,11 +44,15 @@ PER_INTERFACE = ("mu_d", "B", "creep_velocity")
 class LeverParams:
     """Parameters of one virtual run (defaults: the paper's apparatus and the default study)."""
 
+    #: Old names of parameters (:mod:`stickslip.plugin_params`): ``a`` is the interface everywhere else.
+    RENAMED: typing.ClassVar[dict] = {"a": "driven_slab"}
+
     n: int = param(1, "driven slabs (springs attached); 1 for the individual protocol", minimum=1,
                  maximum=100)
-    protocol: str = param("stack", "stack: slabs 1..n driven; individual: slab a alone, slabs below clamped",
-                          choices=PROTOCOLS)
-    a: int = param(0, "slab driven alone (individual protocol); 0 for stack", minimum=0, maximum=100)
+    protocol: str = param("stack", "stack: slabs 1..n driven; individual: slab driven_slab alone, slabs below "
+                                   "clamped", choices=PROTOCOLS)
+    driven_slab: int = param(0, "slab driven alone (individual protocol; its interface slips); 0 for stack",
+                             minimum=0, maximum=100)
     n_slabs: int = param(5, "slabs in the stack", minimum=1, maximum=100)
     seed: int = param(0, "seed of every random stream (disorder, sensor noise)", minimum=0, maximum=2**63 - 1)
     duration: float = param(6000.0, "length of the run (the paper: 0.6 rad at 1e-4 /s)", unit="s",
@@ -57,7 +62,7 @@ class LeverParams:
     k_spring: float = param(55.0, "spring stiffness K", unit="N/mm", minimum=1e-3, maximum=1e5)
     h: float = param(10.0, "slab thickness h", unit="mm", minimum=1e-3, maximum=1e3)
     H: float = param(100.0, "lever height H", unit="mm", minimum=1e-3, maximum=1e4)
-    V: float = param(0.01, "lever-top speed V (individual protocol: the lever moves at V/a)", unit="mm/s",
+    V: float = param(0.01, "lever-top speed V (individual protocol: the lever moves at V/driven_slab)", unit="mm/s",
                      minimum=1e-9, maximum=1e3)
     mu_d: tuple[float, ...] = param((0.35,), "dynamic friction level per interface (one value: all)", minimum=0,
                                    maximum=10)
@@ -124,17 +129,17 @@ def check_memory(params):
 
 
 def check_protocol(params):
-    """Raise ParameterError unless ``n``, ``a`` and ``n_slabs`` fit the protocol (also used by
+    """Raise ParameterError unless ``n``, ``driven_slab`` and ``n_slabs`` fit the protocol (also used by
     :mod:`stickslip.solvers.rate_state_lever`)."""
     if params.protocol == "stack":
         if params.n > params.n_slabs:
             raise ParameterError(f"parameter 'n': expected a value <= n_slabs={params.n_slabs}, got {params.n}")
-        if params.a != 0:
-            raise ParameterError(f"parameter 'a': must be 0 for the stack protocol, got {params.a}")
+        if params.driven_slab != 0:
+            raise ParameterError(f"parameter 'driven_slab': must be 0 for the stack protocol, got {params.driven_slab}")
     else:
-        if not 1 <= params.a <= params.n_slabs:
-            raise ParameterError(f"parameter 'a': expected 1..n_slabs={params.n_slabs} for the individual "
-                                 f"protocol, got {params.a}")
+        if not 1 <= params.driven_slab <= params.n_slabs:
+            raise ParameterError(f"parameter 'driven_slab': expected 1..n_slabs={params.n_slabs} for the individual "
+                                 f"protocol, got {params.driven_slab}")
         if params.n != 1:
             raise ParameterError(f"parameter 'n': must be 1 for the individual protocol, got {params.n}")
 

@@ -34,7 +34,7 @@ __all__ = ["RateStateLeverParams", "run", "VERSION"]
 VERSION = "4"  # 4: coupling matrices in a fixed order (host-independent bits); 2: RODAS4 with relative slip-rate tolerances (issue 12); 3: the friction as state (issue 24)
 
 #: Parameters shared with the ``lever`` solver: apparatus, protocol, drive, sensors.
-SHARED = ("n", "protocol", "a", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",
+SHARED = ("n", "protocol", "driven_slab", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",
           "V", "force_rate", "force_noise", "frame_rate", "position_noise")
 #: Per-interface parameters: one value for every interface, or one per interface.
 PER_INTERFACE = ("rs_a", "rs_b", "D_c", "mu0")
@@ -98,7 +98,8 @@ def _check(self):
 
 
 RateStateLeverParams = dataclasses.make_dataclass(
-    "RateStateLeverParams", _shared_fields() + _OWN, frozen=True, namespace={"check": _check})
+    "RateStateLeverParams", _shared_fields() + _OWN, frozen=True,
+    namespace={"check": _check, "RENAMED": LeverParams.RENAMED})
 RateStateLeverParams.__module__ = __name__
 RateStateLeverParams.__doc__ = ("Parameters of one rate-and-state virtual run: the lever's apparatus, protocol and "
                                 "sensors, and the interfaces' rate-and-state friction and inertia.")
