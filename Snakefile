@@ -19,6 +19,7 @@ include: "workflow/rules/simulate.smk"
 include: "workflow/rules/events.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/database.smk"
+include: "workflow/rules/browse.smk"
 
 
 report: "workflow/report/workflow.rst"

@@ -64,8 +64,8 @@ SMALL = 10
 def affine_response(params, mesh):
     """An affine simple shear (gamma = eps0) as the loading direction, scaled like the true response (timing only:
     no solve; computed on the host's ``structured`` backend, whatever ``params.backend``)."""
-    model, _ = stack_model(params, mesh, derived_constants(params, mesh))
-    backend = make_backend().prepare(model, mesh)
+    model, wells = stack_model(params, mesh, derived_constants(params, mesh))
+    backend = make_backend().prepare(model, mesh, wells.epsy)
     u = np.zeros(model.ndof)
     u[mesh.dofs[:, 0]] = 2.0 * params.eps0 * mesh.coor[:, 1]
     target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height)

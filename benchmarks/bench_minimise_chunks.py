@@ -19,7 +19,7 @@ import numpy as np
 from stickslip.fem.backends import make_backend
 from stickslip.fem.backends.cpu import minimise
 from stickslip.fem.parameters import FemParams
-from stickslip.fem.simulation import Simulation
+from stickslip.fem.simulation import Simulation, make_protocol
 from stickslip.plugin_params import parse_params
 from stickslip.solvers.fem import stack_mesh
 
@@ -45,10 +45,11 @@ def main(argv=None):
         for _ in range(args.repeat):
             for per_call in times:
                 minimise.STEPS_PER_CALL = per_call
-                simulation.stack.restore(*start)
+                simulation.stack.restore(start)
+                protocol = make_protocol(simulation)  # at increment 0: a load comes next
                 begin = time.process_time()
                 for increment in range(1, args.increments + 1):
-                    simulation.protocol.step(increment % 2 == 0, params.margin, increment)
+                    protocol.step(params.margin, increment)
                 times[per_call].append(time.process_time() - begin)
         minimise.STEPS_PER_CALL = chunk
         ratio = np.median(times[chunk]) / np.median(times[ONE_CALL])

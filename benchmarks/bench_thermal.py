@@ -54,18 +54,18 @@ def draw_cost(path, draws):
     replay = EventReplay(path)
     sim = replay.simulation
     with open_file(path) as file:
-        sim.stack.restore(*RunFile(file).state(replay.nstored - 1))
+        sim.stack.restore(RunFile(file).state(replay.nstored - 1))
     p, model = sim.params, sim.model
     idx, eps = sim.backend.read("idx", "eps")
     beta = 1.0 / (p.temperature * energy_unit(p, sim.constants["h"]))
     speed = p.drive_rate / drive_scale(sim.loading.response, p.eps0, sim.mesh)
     ds_c = sim.loading.step_size(False)
-    allowed = np.ones((model.epsy.shape[0], 2), dtype=bool)
+    allowed = np.ones((model.iface_dofs.shape[0], 2), dtype=bool)
     times = []
     for k in range(draws):
         stream = pcg32_seed(np.array([1], dtype=np.uint64), np.array([k], dtype=np.uint64))
         start = time.perf_counter()
-        sample_event(model.law, model.epsy, idx, eps, sim.loading.response.delta_eps, model.iface_dV, allowed, beta,
+        sample_event(model.law, sim.stack.yield_strains, idx, eps, sim.loading.response.delta_eps, model.iface_dV, allowed, beta,
                      p.attempt_rate, 0.0, speed, np.inf, ds_c, *stream)
         times.append(time.perf_counter() - start)
     return float(np.median(times))

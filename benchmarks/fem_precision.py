@@ -46,7 +46,7 @@ def main(argv=None):
     slips = max(int(np.sum(hops.min(axis=1) > 0)), 1)
     top = float(stack.read("ubar")[0][-1])
     per_slip = top / max(hops.min(axis=1).sum(), 1)  # top-plate displacement per well hop of a whole interface
-    u, target, lever, t = stack.stored()
+    stored = stack.stored()
     x = sim.mesh.dofs[:, 0]
     base = observer.observe(observer.well_index())
     print(f"N={args.N} plates={args.plates}: top plate moved {top:.3e} in {hops.min(axis=1).sum()} "
@@ -54,9 +54,9 @@ def main(argv=None):
     print(f"{'T':>8} {'hops':>10} {'residual':>10} {'d sigd':>10} {'d fxdrive':>10} exact-solve")
     floor_T = None
     for T in [0.0, 1.0, 1e1, 1e2, 1e3, 1e4, 1e5]:
-        moved = u.copy()
+        moved = stored.u.copy()
         moved[np.unique(x)] += T
-        stack.restore(moved, target + T, lever, t)
+        stack.restore(stored._replace(u=moved, target=stored.target + T))
         r = sim.backend.residual()
         row = observer.observe(observer.well_index())
         dsig = abs(row["sigd"] / base["sigd"] - 1.0)

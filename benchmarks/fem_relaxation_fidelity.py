@@ -207,7 +207,7 @@ def _kick_outcomes(params, mesh, response, states):
     observer = Observer(sim)
     out = []
     for state in states:
-        sim.stack.restore(*state)
+        sim.stack.restore(state)
         previous = observer.well_index()
         if not sim.protocol.kick(sim.params.margin)[0]:
             raise SystemExit("a kick reached the margin")
@@ -275,7 +275,7 @@ def stability(args):
     bound = np.inf  # 1e3 times the largest kinetic energy with the first dt_scale
     for scale in (*args.scales, 0.95 * limit, 1.05 * limit):
         trial = Simulation(FemParams(**params, dt_scale=scale), mesh, make_backend(), response=sim.loading.response)
-        trial.stack.restore(*kicked)
+        trial.stack.restore(kicked)
         energy = np.empty(args.steps)
         for i in range(args.steps):
             trial.backend.advance(1)

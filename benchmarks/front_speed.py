@@ -65,12 +65,12 @@ def replays(path, scales, max_events):
         sim = Simulation(dataclasses.replace(params, dt_scale=float(scale)), mesh, make_backend(params.backend),
                          response=response)
         for increment, (before, after) in states.items():
-            sim.stack.restore(*before)
+            sim.stack.restore(before)
             kick = KickAlongResponse(sim.loading, bool(yield_element[increment]))
             _, events = sim.protocol.perturb_and_relax(kick, params.margin, record=True)
-            reproduced = bool(np.array_equal(sim.backend.read("u")[0], after[0]))
+            reproduced = bool(np.array_equal(sim.backend.read("u")[0], after.u))
             element = events[:, 0].astype(np.int64)
-            failures = pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - before[3],
+            failures = pd.DataFrame({"a": element // N + 1, "block": element % N, "t": events[:, 1] - before.t,
                                      "direction": events[:, 2].astype(np.int64)})
             yield increment, float(scale), failures, reproduced
 

@@ -1,7 +1,7 @@
 """The public API of the package, for notebooks and scripts (docs/tutorial.md).
 
-Five functions, each a thin layer over what the command line and the workflow run, so that a
-call here gives what the command gives:
+Functions, each a thin layer over what the command line and the workflow run, so that a call
+here gives what the command gives:
 
 - :func:`simulate`: ``stickslip simulate`` (same validation and messages, resume, overwrite rule);
 - :func:`open_run`: a simulation file's header, tables and states (the format's reader, the

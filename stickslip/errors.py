@@ -6,7 +6,7 @@ that code catching those keeps working, and the command line prints it as one li
 
 from .h5io import FileFormatError
 
-__all__ = ["StudyNotFoundError", "RunNotFoundError", "IncrementError"]
+__all__ = ["StudyNotFoundError", "RunNotFoundError", "IncrementError", "SolverError"]
 
 
 class StudyNotFoundError(FileFormatError, FileNotFoundError):
@@ -19,3 +19,9 @@ class RunNotFoundError(FileFormatError, LookupError):
 
 class IncrementError(FileFormatError, IndexError):
     """An increment that a run file does not store (the message gives the stored range)."""
+
+
+class SolverError(RuntimeError):
+    """A solver cannot go on with the run its parameters describe (no convergence, no yielding step found, an
+    integration that failed); the message says why, in one line. The command line prints it as a user's error
+    (exit status 2): the parameters asked for a run the method cannot make."""

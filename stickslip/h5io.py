@@ -23,8 +23,9 @@ What keeps outputs safe (atomic renames, locks, free space, the write guard thro
 
 Files are not trusted: before a read allocates anything, :func:`read_array` checks the size the file
 declares against what it stores (a dataset cannot hold more numbers than its chunks, compressed at most
-:data:`MAX_EXPANSION` to one) and against a memory budget (:func:`read_budget`: half of what this process
-can still allocate, at most ``STICKSLIP_READ_LIMIT_MIB``), and reads large selections in blocks; a file
+:data:`MAX_EXPANSION` to one; rows in a chunk that was never written are not stored, :mod:`.stored_rows`)
+and against a memory budget (:func:`read_budget`: half of what this process can still allocate, at most
+``STICKSLIP_READ_LIMIT_MIB``; :func:`read_table` budgets a table whole), and reads large selections in blocks; a file
 whose HDF5 metadata fail their checksums raises :class:`CorruptFileError` naming it wherever it is read
 (:func:`open_file`). Each is one line naming the file and the dataset.
 """
@@ -32,7 +33,6 @@ whose HDF5 metadata fail their checksums raises :class:`CorruptFileError` naming
 import json
 import math
 import os
-import resource
 import time
 from pathlib import Path
 
@@ -40,13 +40,15 @@ import h5py
 import numpy as np
 import pandas as pd
 
+from .machine_memory import room_left, size_text
 from .output_safety.errors import OutputError
 from .output_safety.torn_chunk import committed_rows
 from .output_safety.write_guard import WriteGuard
+from .stored_rows import data_elsewhere, first_unstored_row
 
-__all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs", "copy_file",
-           "attribute", "read_budget", "FileFormatError", "UnreadableFileError", "CorruptFileError", "ReadBudgetError",
-           "READ_LIMIT_VARIABLE", "MAX_EXPANSION"]
+__all__ = ["open_file", "write_dataset", "read_array", "read_datasets", "write_table", "read_table", "write_attrs",
+           "copy_file", "attribute", "read_budget", "check_budget", "FileFormatError", "UnreadableFileError",
+           "CorruptFileError", "ReadBudgetError", "READ_LIMIT_VARIABLE", "MAX_EXPANSION"]
 
 LIBVER = ("v110", "v110")
 
@@ -96,30 +98,6 @@ class ReadBudgetError(FileFormatError):
     """Reading a dataset would take more memory than the budget of one read (:func:`read_budget`)."""
 
 
-def _meminfo(field):
-    """A field of /proc/meminfo [B] (None where there is none)."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as info:
-            for line in info:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
-
-
-def _own(field):
-    """A field of /proc/self/status [B] (0 where there is none)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith(field + ":"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return 0
-
-
 def read_budget():
     """The most one read of a dataset may allocate [B]: half of what this process can still allocate.
 
@@ -133,12 +111,7 @@ def read_budget():
     float
         [B]; ``inf`` where nothing limits it.
     """
-    room = [_meminfo("MemAvailable")]
-    for limit, used in ((resource.RLIMIT_AS, "VmSize"), (resource.RLIMIT_DATA, "VmData")):
-        soft = resource.getrlimit(limit)[0]
-        if soft != resource.RLIM_INFINITY:
-            room.append(max(0, soft - _own(used)))
-    budget = 0.5 * min((r for r in room if r is not None), default=math.inf)
+    budget = 0.5 * room_left()
     capped = os.environ.get(READ_LIMIT_VARIABLE)
     if capped:
         try:
@@ -157,36 +130,84 @@ def _selected_shape(shape, selection):
     return tuple(out) + tuple(shape[len(items):])
 
 
-def _size(nbytes):
-    """``nbytes`` as a short text (B, KiB, MiB, GiB)."""
-    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if nbytes >= scale:
-            return f"{nbytes / scale:.3g} {unit}"
-    return f"{nbytes:.0f} B"
+def _nbytes(dataset, shape):
+    """Bytes that ``shape`` of ``dataset`` takes in memory (a variable-length element: :data:`_OBJECT_BYTES`)."""
+    itemsize = _OBJECT_BYTES if dataset.dtype.kind == "O" else dataset.dtype.itemsize
+    return float(np.prod(shape, dtype=float)) * itemsize
 
 
 def _check_size(dataset, shape):
     """Raise unless reading ``shape`` of ``dataset`` is consistent with what the file stores and fits the budget."""
-    itemsize = _OBJECT_BYTES if dataset.dtype.kind == "O" else dataset.dtype.itemsize
-    nbytes = float(np.prod(shape, dtype=float)) * itemsize
+    nbytes = _nbytes(dataset, shape)
     if nbytes <= _BLOCK_BYTES:  # small: allocated at once whatever the file says
         return
-    name = f"{dataset.file.filename}: dataset {dataset.name}"
+    _check_storage(dataset, shape)
+    check_budget(nbytes, f"{dataset.file.filename}: dataset {dataset.name}: reading {shape} {dataset.dtype}")
+
+
+def _check_storage(dataset, shape):
+    """Raise CorruptFileError if ``shape`` of ``dataset`` (more than 64 MiB) is more than its file's storage of it
+    can hold: its bytes, compressed at most :data:`MAX_EXPANSION` to one, plus one chunk."""
+    nbytes = _nbytes(dataset, shape)
     plist = dataset.id.get_create_plist()
     filters = {plist.get_filter(i)[0] for i in range(plist.get_nfilters())}
-    if dataset.dtype.kind != "O" and filters <= _COMPRESSING | _KEEPING:
-        stored = dataset.id.get_storage_size()
-        expansion = MAX_EXPANSION if filters & _COMPRESSING else 1
-        chunk = float(np.prod(dataset.chunks, dtype=float)) * itemsize if dataset.chunks else 0.0
-        if nbytes > stored * expansion + chunk:
-            raise CorruptFileError(f"{name} declares {shape} {dataset.dtype} ({_size(nbytes)}) but stores "
-                                   f"{_size(stored)}{' compressed' if expansion > 1 else ''}: the file is damaged or "
-                                   "not what it claims; remake it (rerun the job that wrote it)")
+    if nbytes <= _BLOCK_BYTES or dataset.dtype.kind == "O" or not filters <= _COMPRESSING | _KEEPING:
+        return
+    stored = dataset.id.get_storage_size()
+    expansion = MAX_EXPANSION if filters & _COMPRESSING else 1
+    chunk = _nbytes(dataset, dataset.chunks) if dataset.chunks else 0.0
+    if nbytes > stored * expansion + chunk:
+        compressed = " compressed" if expansion > 1 else ""
+        raise CorruptFileError(f"{dataset.file.filename}: dataset {dataset.name} declares {shape} {dataset.dtype} "
+                               f"({size_text(nbytes)}) but stores {size_text(stored)}{compressed}: the file is "
+                               "damaged or not what it claims; remake it (rerun the job that wrote it)")
+
+
+def check_budget(nbytes, what):
+    """Raise ReadBudgetError if ``nbytes`` are more than :func:`read_budget`; ``what`` starts the message.
+
+    Parameters
+    ----------
+    nbytes : float
+        [B] that a read would allocate.
+    what : str
+        What would be read, naming the file (e.g. ``"run.h5: table 'increments' of 41 rows"``).
+    """
     budget = read_budget()
     if nbytes > budget:
-        raise ReadBudgetError(f"{name}: reading {shape} {dataset.dtype} would take {_size(nbytes)}, beyond the "
-                              f"memory budget of one read ({_size(budget)}: half of what this process can still "
-                              f"allocate, or {READ_LIMIT_VARIABLE})")
+        raise ReadBudgetError(f"{what} would take {size_text(nbytes)}, beyond the memory budget of one read "
+                              f"({size_text(budget)}: half of what this process can still allocate, or "
+                              f"{READ_LIMIT_VARIABLE})")
+
+
+def _selected_rows(shape, selection):
+    """The rows ``(start, stop)`` along the first axis that a selection of integers and slices touches (else all)."""
+    items = selection if isinstance(selection, tuple) else (selection,)
+    if not shape or not items or items[0] is Ellipsis:
+        return 0, shape[0] if shape else 0
+    first = items[0]
+    if isinstance(first, (int, np.integer)):
+        row = int(first) + (shape[0] if first < 0 else 0)
+        return row, row + 1
+    if isinstance(first, slice):
+        picked = range(*first.indices(shape[0]))
+        return (min(picked), max(picked) + 1) if picked else (0, 0)
+    return 0, shape[0]
+
+
+def _check_stored(dataset, start, stop):
+    """Raise CorruptFileError unless the file stores rows ``start ... stop - 1`` of ``dataset`` itself
+    (:mod:`stickslip.stored_rows`): never a fill value where a chunk was never written, never data of other files."""
+    name = f"{dataset.file.filename}: dataset {dataset.name}"
+    elsewhere = data_elsewhere(dataset)
+    if elsewhere:
+        raise CorruptFileError(f"{name} {elsewhere}, which this package never writes: the file is not what it "
+                               "claims; remake it (rerun the job that wrote it)")
+    row = first_unstored_row(dataset, start, stop)
+    if row is not None:
+        raise CorruptFileError(f"{name} declares {dataset.shape[0]} rows but stores none from row {row} on (a "
+                               f"chunk never written reads as zeros): the file is damaged or not what it claims; "
+                               f"remake it (rerun the job that wrote it)")
 
 
 def _blocks(rows, row_bytes, chunk_rows):
@@ -358,7 +379,9 @@ def read_array(dataset, selection=()):
     CorruptFileError
         If HDF5 cannot read the data: a checksum (:func:`write_dataset`) or the
         decompression of a chunk failed; or the dataset declares more data than the
-        file stores. The message names the file and dataset.
+        file stores (more than its storage can hold, rows in chunks that were never written:
+        :mod:`stickslip.stored_rows`) or keeps its data in other files. The message names the file and
+        dataset.
         In a file being written (SWMR), where a chunk may be read while its writer
         rewrites it, the read is tried :data:`_SWMR_READ_ATTEMPTS` times first.
     ReadBudgetError
@@ -371,17 +394,27 @@ def read_array(dataset, selection=()):
     """
     shape = _selected_shape(dataset.shape, selection)
     _check_size(dataset, shape)
+    _check_stored(dataset, *_selected_rows(dataset.shape, selection))
     items = selection if isinstance(selection, tuple) else (selection,)
-    row_bytes = dataset.dtype.itemsize * int(np.prod(shape[1:], dtype=np.int64)) if shape else 0
     whole_rows = items in ((), (slice(None),)) or (len(items) == 1 and isinstance(items[0], slice)
                                                     and items[0].step in (None, 1))
-    if shape and whole_rows and dataset.dtype.kind != "O" and shape[0] * row_bytes > _BLOCK_BYTES:
+    if shape and whole_rows and dataset.dtype.kind != "O":
         first = items[0].indices(dataset.shape[0])[0] if items else 0
-        out = np.empty(shape, dtype=dataset.dtype)
-        for start, stop in _blocks(shape[0], row_bytes, dataset.chunks[0] if dataset.chunks else 1):
-            out[start:stop] = _read(dataset, slice(first + start, first + stop))
-        return out
+        return _read_rows(dataset, first, first + shape[0])
     return _read(dataset, selection)
+
+
+def _read_rows(dataset, start, stop):
+    """Rows ``start ... stop - 1`` of a dataset of fixed-size elements: more than 64 MiB in blocks of whole chunks
+    into one array (no temporary of its size); raises CorruptFileError (:func:`read_array`, no checks of its own)."""
+    shape = (stop - start,) + dataset.shape[1:]
+    if _nbytes(dataset, shape) <= _BLOCK_BYTES:
+        return _read(dataset, slice(start, stop))
+    out = np.empty(shape, dtype=dataset.dtype)
+    row_bytes = dataset.dtype.itemsize * int(np.prod(shape[1:], dtype=np.int64))
+    for low, high in _blocks(shape[0], row_bytes, dataset.chunks[0] if dataset.chunks else 1):
+        out[low:high] = _read(dataset, slice(start + low, start + high))
+    return out
 
 
 def _read(dataset, selection):
@@ -544,6 +577,10 @@ def read_table(group, name, rows=None):
     FileFormatError
         If the table is missing or malformed: its ``columns`` attribute is not a JSON list of names, a
         column is not a 1-D dataset, or the columns have other lengths (fewer than ``rows``).
+    CorruptFileError
+        If a column's file does not store its rows (:func:`read_array`).
+    ReadBudgetError
+        If the table would take more memory than :func:`read_budget`; checked before any column is read.
     """
     where = f"{group.file.filename}: table '{name}'"
     if name not in group or not isinstance(group[name], h5py.Group) or "columns" not in group[name].attrs:
@@ -565,6 +602,7 @@ def read_table(group, name, rows=None):
         column, n = next(iter(short.items()))
         raise FileFormatError(f"{where}: column '{column}' has {n} rows, expected {expected}"
                               f"{' (the rows the file says it stores)' if rows is not None else ''}")
+    check_budget(sum(_nbytes(sub[column], (expected,)) for column in columns), f"{where} of {expected} rows")
     data = {}
     for column in columns:
         growing = rows is not None and sub[column].maxshape[0] is None
@@ -613,10 +651,12 @@ def copy_file(source, target, rows):
             if not shape:
                 out[()] = read_array(obj)
             elif shape[0]:
+                _check_storage(obj, shape)
+                _check_stored(obj, 0, shape[0])
                 row_bytes = obj.dtype.itemsize * int(np.prod(shape[1:]))
                 for start, stop in _blocks(shape[0], row_bytes, obj.chunks[0] if obj.chunks else 1):
-                    out[start:stop] = _read_committed(obj, start, stop, rows) if growable else \
-                        read_array(obj, slice(start, stop))
+                    out[start:stop] = _through_torn(obj, start, stop, rows) if growable else \
+                        _read_rows(obj, start, stop)
             copy_attrs(obj, out)
 
     copy_group(source, target)
@@ -625,25 +665,38 @@ def copy_file(source, target, rows):
 def _read_committed(dataset, start, stop, committed):
     """Rows ``start ... stop - 1`` (``stop <= committed``) of a growable dataset, through a chunk torn by a kill.
 
+    The rows are checked against what the file stores and the memory budget before anything is read
+    (:func:`read_array`'s checks), then read by :func:`_through_torn`.
+
     Raises
     ------
     CorruptFileError
-        If a chunk cannot be read and is not a torn chunk whose committed rows its old checksum proves
-        (:func:`stickslip.output_safety.torn_chunk.committed_rows`).
+        If the file does not store the rows, or a chunk cannot be read and is not a torn chunk whose
+        committed rows its old checksum proves (:func:`stickslip.output_safety.torn_chunk.committed_rows`).
+    ReadBudgetError
+        If the rows would take more memory than :func:`read_budget`.
     """
+    _check_size(dataset, (stop - start,) + dataset.shape[1:])
+    _check_stored(dataset, start, stop)
+    return _through_torn(dataset, start, stop, committed)
+
+
+def _through_torn(dataset, start, stop, committed):
+    """Rows ``start ... stop - 1`` of a growable dataset (checked), a chunk that fails to read replaced by its
+    committed rows where its old checksum proves them, in the one array of the result."""
     try:
-        return read_array(dataset, slice(start, stop))
+        return _read_rows(dataset, start, stop)
     except CorruptFileError as error:
         damage = str(error)  # not the exception: its traceback would keep the caller's datasets open
     size = dataset.chunks[0]
-    parts = []
+    out = np.empty((stop - start,) + dataset.shape[1:], dtype=dataset.dtype)
     for first in range(start - start % size, stop, size):
         low, high = max(first, start), min(first + size, stop)
         try:
-            parts.append(read_array(dataset, slice(low, high)))
+            out[low - start:high - start] = _read(dataset, slice(low, high))
         except CorruptFileError:
             rows = committed_rows(dataset, first, committed)
             if rows is None:
                 raise CorruptFileError(damage) from None
-            parts.append(rows[low - first:high - first])
-    return np.concatenate(parts)
+            out[low - start:high - start] = rows[low - first:high - first]
+    return out

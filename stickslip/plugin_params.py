@@ -15,6 +15,10 @@ Supported field types: ``int``, ``float``, ``bool``, ``str`` and tuples
 A dataclass may define ``check(self)``, called after the per-field checks, for
 conditions that involve several fields; it raises :class:`ParameterError`.
 
+A parameter renamed keeps its old name as an alias: the dataclass's ``RENAMED`` (a ``ClassVar``, old name -> new
+name) maps a value given under the old name to the new one, with a :class:`RenamedParameterWarning` (the config's
+schema accepts it too); a value given under both names is refused.
+
 A field added to a plugin after runs were made is declared with ``extension=True``:
 while it has its default it is left out of :func:`params_to_dict`, so the run ids,
 stored parameters and files of the runs made before it keep their bytes (its default
@@ -29,11 +33,13 @@ import dataclasses
 import difflib
 import math
 import typing
+import warnings
 from collections.abc import Iterable, Mapping
 
 __all__ = [
     "ParameterError",
     "ParameterWarning",
+    "RenamedParameterWarning",
     "param",
     "parse_params",
     "parse_value",
@@ -42,6 +48,7 @@ __all__ = [
     "params_to_dict",
     "json_schema",
     "describe",
+    "value_range",
 ]
 
 
@@ -51,6 +58,27 @@ class ParameterError(ValueError):
 
 class ParameterWarning(UserWarning):
     """Parameters that the method represents but outside the regime where it was studied; the message says which."""
+
+
+class RenamedParameterWarning(ParameterWarning, FutureWarning):
+    """A parameter given under its old name (a dataclass's ``RENAMED``): it is mapped to the new one.
+
+    A ``FutureWarning``: shown by default, as Python shows warnings meant for the users of a package.
+    """
+
+
+def _renamed(cls, values, owner):
+    """``values`` (a dict, changed in place) with every old name of ``cls.RENAMED`` replaced by its new one."""
+    for old, new in getattr(cls, "RENAMED", {}).items():
+        if old not in values:
+            continue
+        where = f" of {owner}" if owner else ""
+        if new in values:
+            raise ParameterError(f"parameter '{old}'{where} is '{new}' now; give '{new}' alone")
+        warnings.warn(f"parameter '{old}'{where} is called '{new}' now (the old name is mapped, and will go)",
+                      RenamedParameterWarning, stacklevel=4)
+        values[new] = values.pop(old)
+    return values
 
 
 def param(default, doc, *, unit="", choices=None, minimum=None, maximum=None, exclusive_minimum=None,
@@ -123,7 +151,7 @@ def _convert_scalar(name, value, kind):
         if isinstance(value, str):
             return value
         raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
-    if isinstance(value, bool):
+    if isinstance(value, (bool, bytes, bytearray)):
         raise ParameterError(f"parameter '{name}': expected {expected}, got {value!r}")
     try:
         if kind is int:
@@ -164,7 +192,7 @@ def _convert(name, value, annotation, meta):
         if text[:1] + text[-1:] in ("[]", "()"):  # the YAML and Python forms: [1e3, 1e6]
             text = text[1:-1]
         items = [item for item in text.split(",") if item.strip()]
-    elif isinstance(value, Iterable):
+    elif isinstance(value, Iterable) and not isinstance(value, (bytes, bytearray)):
         items = list(value)
     else:
         items = [value]
@@ -201,7 +229,7 @@ def parse_params(cls, values=None, *, owner=""):
         wrong type or out of range (the message names the field and the expectation),
         or a failed ``check()``.
     """
-    values = dict(values or {})
+    values = _renamed(cls, dict(values or {}), owner)
     types = _field_types(cls)
     unknown = sorted(set(values) - set(types))
     if unknown:
@@ -243,6 +271,7 @@ def parse_value(cls, name, value, *, owner=""):
     ParameterError
         If ``cls`` has no such field, or the value does not fit it.
     """
+    name = next(iter(_renamed(cls, {name: value}, owner)))
     types = _field_types(cls)
     if name not in types:
         where = f" of {owner}" if owner else ""
@@ -295,11 +324,11 @@ def did_you_mean(name, choices):
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
-def params_to_dict(instance):
+def params_to_dict(instance, *, every=False):
     """Return the parameters as a JSON-safe dict (tuples become lists), in field order.
 
     Fields declared with ``extension=True`` are left out while they have their default; those
-    declared with ``extension="<field>"`` while that field has its default too.
+    declared with ``extension="<field>"`` while that field has its default too; ``every=True``: none is.
     """
     fields = {f.name: f for f in dataclasses.fields(instance)}
 
@@ -313,7 +342,7 @@ def params_to_dict(instance):
         return at_default(f.name) and (extension is True or at_default(extension))
 
     return {f.name: list(v) if isinstance(v := getattr(instance, f.name), tuple) else v
-            for f in fields.values() if not left_out(f)}
+            for f in fields.values() if every or not left_out(f)}
 
 
 _JSON_TYPES = {int: "integer", float: "number", bool: "boolean", str: "string"}
@@ -350,6 +379,9 @@ def json_schema(cls):
         unit = f" [{meta['unit']}]" if meta.get("unit") else ""
         prop["description"] = meta.get("doc", "") + unit
         properties[f.name] = prop
+    for old, new in getattr(cls, "RENAMED", {}).items():  # accepted, mapped by parse_params; no default to fill in
+        properties[old] = {**{k: v for k, v in properties[new].items() if k != "default"}, "deprecated": True,
+                           "description": f"the old name of {new}"}
     return {"type": "object", "properties": properties, "additionalProperties": False}
 
 
@@ -379,5 +411,25 @@ def describe(cls):
             doc += f" (one of: {listed})"
         elif choices is not None:
             doc += f" (one of: {', '.join(map(str, choices))})"
+        bounds = value_range(f.metadata)
+        if bounds:
+            doc += f" (range: {bounds})"
         rows.append((f.name, type_name, f.default, f.metadata.get("unit", ""), doc))
     return rows
+
+
+def value_range(meta):
+    """The bounds of a parameter (for a tuple: of every element) as text, e.g. ``> 0, <= 8``; "" if it has none.
+
+    Parameters
+    ----------
+    meta : Mapping
+        A field's metadata (:func:`param`).
+
+    Returns
+    -------
+    str
+    """
+    bounds = [(">=", meta.get("minimum")), (">", meta.get("exclusive_minimum")), ("<=", meta.get("maximum"))]
+    return ", ".join(f"{sign} {value if isinstance(value, int) else format(value, 'g')}" for sign, value in bounds
+                     if value is not None)

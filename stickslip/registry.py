@@ -17,6 +17,10 @@ of the plugin's kind (:data:`ENTRY_POINT_GROUPS`) that names the module to impor
     [project.entry-points."stickslip.solvers"]
     mysolver = "mypackage.mysolver"
 
+(:mod:`stickslip.discovery`; docs/writing-a-plugin.md). The parts a solver's run chooses by name with a
+parameter (the ``fem`` solver's interface laws and backends, with their own entry-point groups) are declared
+as its :class:`Choice` s, so that a run's code hash covers the part it chooses and no other.
+
 Call signatures by kind (checked when a plugin registers):
 
 - ``solver``: ``run(params, output, *, threads, inputs)``: write one file of the
@@ -37,12 +41,11 @@ Call signatures by kind (checked when a plugin registers):
 import dataclasses
 import importlib
 import inspect
-import pkgutil
 import re
-from collections.abc import Callable
-from importlib.metadata import entry_points
+from collections.abc import Callable, Mapping
 
 from . import formats
+from .discovery import PluginError, import_modules, load_entry_points
 from .h5io import FileFormatError
 from .hashing import short_hash
 from .plugin_params import params_to_dict
@@ -53,6 +56,8 @@ __all__ = [
     "BUILTIN_PACKAGES",
     "Plugin",
     "DeviceBatching",
+    "Choice",
+    "NoParameters",
     "PluginError",
     "register",
     "get",
@@ -83,10 +88,6 @@ _plugins = {kind: {} for kind in KINDS}
 _loaded = False
 
 
-class PluginError(LookupError):
-    """A plugin is malformed, registered twice, or not found."""
-
-
 @dataclasses.dataclass(frozen=True)
 class DeviceBatching:
     """How a solver's runs share one device in batches: a capability a solver declares (``device_batch``).
@@ -110,6 +111,40 @@ class DeviceBatching:
     on_device: Callable
     shared: tuple
     run: Callable
+
+
+@dataclasses.dataclass(frozen=True)
+class Choice:
+    """A part of a solver's runs chosen by name with one of its parameters (``fem``: the interface law, the backend).
+
+    The parts register themselves in :attr:`registered` (built-in ones: every module of their package;
+    other packages' through an entry-point group, :mod:`stickslip.discovery`). A run's code hash covers the
+    part it chooses and no other (:func:`stickslip.provenance.code.plugin_code_hash`).
+
+    Attributes
+    ----------
+    parameter : str
+        The solver's parameter whose value names the part (e.g. ``"interface_law"``).
+    registered : Mapping[str, type]
+        The live registry of the parts by name: each value is the class of a part, defined in the module that
+        registers it (its ``__module__``).
+    """
+
+    parameter: str
+    registered: Mapping
+
+    def module(self, params):
+        """The module of the part that ``params`` (an instance of the solver's parameters) chooses."""
+        return self.registered[getattr(params, self.parameter)].__module__
+
+    def modules(self):
+        """The modules of every registered part (a frozenset of dotted names)."""
+        return frozenset(part.__module__ for part in self.registered.values())
+
+
+@dataclasses.dataclass(frozen=True)
+class NoParameters:
+    """The parameters of a plugin that has none (``register(..., params=None)``)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -145,6 +180,8 @@ class Plugin:
         make the run (e.g. a GPU backend without a GPU); called before any output is claimed or written.
     device_batch : DeviceBatching or None
         Solvers: how runs share a device in batches (None: every run is one job).
+    choices : tuple[Choice, ...]
+        Solvers: the parts of a run chosen by name with a parameter (an interface law, a backend).
     module : str
         Module that defined it.
     """
@@ -161,6 +198,7 @@ class Plugin:
     replay: Callable | None = None
     preflight: Callable | None = None
     device_batch: DeviceBatching | None = None
+    choices: tuple = ()
     module: str = ""
 
 
@@ -221,10 +259,17 @@ def _check_contract(plugin):
         unknown = [name for name in batching.shared if name not in fields]
         if unknown:
             raise PluginError(f"{where}: device_batch shares parameters it does not have: {', '.join(unknown)}")
+    if plugin.choices:
+        fields = {f.name for f in dataclasses.fields(plugin.params)}
+        if plugin.kind != "solver" or not all(isinstance(choice, Choice) for choice in plugin.choices):
+            raise PluginError(f"{where}: choices must be Choice objects of a solver")
+        unknown = [choice.parameter for choice in plugin.choices if choice.parameter not in fields]
+        if unknown:
+            raise PluginError(f"{where}: choices name parameters it does not have: {', '.join(unknown)}")
 
 
-def register(kind, name, version, params, *, summary="", consumes=(), produces=None, inputs=(), replay=None,
-             preflight=None, device_batch=None):
+def register(kind, name, version, params=None, *, summary="", consumes=(), produces=None, inputs=(), replay=None,
+             preflight=None, device_batch=None, choices=()):
     """Decorator that registers a plugin function.
 
     Parameters
@@ -234,11 +279,11 @@ def register(kind, name, version, params, *, summary="", consumes=(), produces=N
         Plugin name, unique within ``kind``.
     version : str
         Algorithm version.
-    params : type
-        Parameter dataclass.
+    params : type, optional
+        Parameter dataclass; None (default): the plugin has no parameters (:class:`NoParameters`).
     summary : str, optional
         One line for listings; defaults to the first line of the docstring.
-    consumes, produces, inputs, replay, preflight, device_batch
+    consumes, produces, inputs, replay, preflight, device_batch, choices
         The plugin's contract (see :class:`Plugin`).
 
     Returns
@@ -254,10 +299,10 @@ def register(kind, name, version, params, *, summary="", consumes=(), produces=N
 
     def decorator(function):
         doc = (inspect.getdoc(function) or "").strip().splitlines()
-        plugin = Plugin(kind=kind, name=name, version=version, params=params, run=function,
-                        summary=summary or (doc[0] if doc else ""), consumes=tuple(consumes), produces=produces,
-                        inputs=tuple(inputs), replay=replay, preflight=preflight, device_batch=device_batch,
-                        module=function.__module__)
+        plugin = Plugin(kind=kind, name=name, version=version, params=NoParameters if params is None else params,
+                        run=function, summary=summary or (doc[0] if doc else ""), consumes=tuple(consumes),
+                        produces=produces, inputs=tuple(inputs), replay=replay, preflight=preflight,
+                        device_batch=device_batch, choices=tuple(choices), module=function.__module__)
         _check_shape(plugin)
         existing = _plugins[kind].get(name)
         if existing is not None and (existing.module, existing.run.__qualname__) != (
@@ -275,15 +320,9 @@ def _load():
         return
     _loaded = True
     for name in BUILTIN_PACKAGES:
-        package = importlib.import_module(name)
-        for module in pkgutil.iter_modules(package.__path__):
-            importlib.import_module(f"{name}.{module.name}")
-    for kind, group in ENTRY_POINT_GROUPS.items():
-        for entry in entry_points(group=group):
-            try:
-                entry.load()
-            except Exception as error:  # a broken third-party plugin must say so, not vanish
-                raise PluginError(f"entry point {entry.name!r} in group {group!r} failed to load: {error}") from error
+        import_modules(name)
+    for group in ENTRY_POINT_GROUPS.values():
+        load_entry_points(group)
 
 
 def available(kind):

@@ -32,6 +32,7 @@ from .errors import IncrementError
 from .h5io import FileFormatError, attribute, open_file
 from .output_safety.overwrite import root_attributes
 from .plugin_params import parse_params
+from .provenance.record import read_record, record_path
 from .vocabulary import with_units
 
 __all__ = ["open_run", "FemRun", "RunState", "TimeseriesRun", "READERS"]
@@ -51,6 +52,36 @@ class _Run:
         """Free the tables, mesh and models read or built so far; the run reads them again if used."""
         for name in self._cached:
             self.__dict__.pop(name, None)
+
+    @property
+    def provenance(self):
+        """The provenance record beside the file (``<stem>.provenance.json``; a dict,
+        :func:`stickslip.provenance.record.read_record`): what a workflow job or :func:`stickslip.simulate` wrote
+        when it made the file (run id, plugin and version, code hash, git commit, every parameter, host, times,
+        the output's sha256). None where there is none (a lab recording, a file copied without it).
+
+        Raises
+        ------
+        stickslip.h5io.FileFormatError
+            If the record is there but unreadable.
+        """
+        record = record_path(self.path)
+        return read_record(record) if record.is_file() else None
+
+    @property
+    def run_id(self):
+        """The run's id (16 hexadecimal characters): its record's, else the id its solver, solver version and
+        parameters give (:func:`stickslip.registry.run_id`, as the workflow names its file); None for a lab
+        recording or a solver that is not installed at the file's version."""
+        if self.provenance is not None:
+            return self.provenance["run_id"]
+        try:
+            plugin = registry.get("solver", self.solver) if self.solver else None
+        except registry.PluginError:
+            return None
+        if plugin is None or str(self.header.get("solver_version")) != str(plugin.version):
+            return None
+        return registry.run_id(plugin, parse_params(plugin.params, self.params, owner=f"solver '{plugin.name}'"))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -78,7 +109,7 @@ class RunState:
         its block's yield-strain sequence.
     further : dict[str, numpy.ndarray]
         The producer's further state of that increment (``fem`` with junction aging: ``junction_depth``
-        float64 [n_interfaces * N] [G eps0^2 h^2], ``junction_well`` int64 [n_interfaces * N], -1: no
+        float64 [n_interfaces * N] in G eps0^2 h^2, ``junction_well`` int64 [n_interfaces * N], -1: no
         junction); empty for a run without it.
     """
 
@@ -272,9 +303,9 @@ class TimeseriesRun(_Run):
     ----------
     path : pathlib.Path
     record : stickslip.experiment.timeseries.ExperimentRecord
-        The lever force ``t_F`` [s], ``F`` [N], the slab positions ``t_x`` [s], ``x`` [n_frames, n_slabs]
-        [mm], and the apparatus: ``n``, ``n_slabs``, ``protocol``, ``a``, ``normal_force`` [N],
-        ``k_spring`` [N/mm], ``h``, ``H`` [mm], ``V`` [mm/s].
+        The lever force ``t_F`` [s], ``F`` [N], the slab positions ``t_x`` [s], ``x`` (n_frames x n_slabs, in
+        mm), and the apparatus: ``n``, ``n_slabs``, ``protocol``, ``a`` (the driven slab: the file's attribute),
+        ``normal_force`` [N], ``k_spring`` [N/mm], ``h``, ``H`` [mm], ``V`` [mm/s].
     header : dict
         Every root attribute (JSON decoded): the apparatus; a virtual run's ``solver``, ``params``, ``seed``.
     params : dict
@@ -370,10 +401,11 @@ class TimeseriesRun(_Run):
         params = parse_params(ExperimentEventsParams, analysis_params, owner=f"analysis '{EXPERIMENT_EVENTS}'")
         slips, _ = analyse_record(self.record, params)
         fits = fit_single_slips(slips, t0=params.t0, fit=fit, per_interface=per_interface)
-        for each in fits.values() if per_interface else (fits,):
-            if hasattr(each, "bins"):
-                with_units(each.bins)
-        return fits
+
+        def with_unit_bins(each):
+            return dataclasses.replace(each, bins=with_units(each.bins)) if hasattr(each, "bins") else each
+
+        return {a: with_unit_bins(each) for a, each in fits.items()} if per_interface else with_unit_bins(fits)
 
     def truth(self, table="truth"):
         """The ground truth of a virtual run: ``"truth"`` (one row per slip made) or ``"interfaces"``.

@@ -38,7 +38,7 @@ from . import mesh, registry
 from .hashing import short_hash
 from .lineage import Artifact
 from .plugin_params import ParameterError, json_schema, params_to_dict, parse_params
-from .provenance.code import code_hash
+from .provenance.code import code_hash, plugin_code_hash
 from .provenance.record import record_path
 
 __all__ = ["RESULTS", "PATHS", "study_name", "check_study_name", "SimulationJob", "AnalysisJob", "FigureJob", "Study",
@@ -58,6 +58,7 @@ PATHS = {
     "events": "events/{analysis}/{solver}/{run_id}.h5",
     "figure": "figures/{figure}.pdf",
     "database": "stickslip.sqlite",
+    "added": "added/{solver}/{run_id}.h5",
     "logs": "logs",
     "benchmark": "logs/benchmarks/sim/{solver}/{run_id}.tsv",
     "events_benchmark": "logs/benchmarks/events/{analysis}/{solver}/{run_id}.tsv",
@@ -561,12 +562,28 @@ class Study:
         paths += [job.path for job in self.figures.values()]
         return sorted(record_path(p).as_posix() for p in paths)
 
+    def added_records(self):
+        """The records of the simulations added to the study (:meth:`stickslip.study_results.StudyResults.add`),
+        sorted: the database rule ingests them too."""
+        return sorted(path.as_posix() for path in Path(self.root).glob(PATHS["added"].format(solver="*", run_id="*")
+                                                                          .replace(".h5", ".provenance.json")))
+
     @staticmethod
     def code(kind, name):
-        """Return the code hash of a plugin (``kind`` "mesh" for the mesh writer)."""
+        """Return the code hash of the jobs of an analysis or figure (``kind`` "mesh": of the mesh writer's).
+
+        A simulation's depends on its parameters: :meth:`simulation_code`.
+        """
         if kind == "mesh":
             return code_hash(mesh.write_mesh.__module__)
-        return code_hash(registry.get(kind, registry.config_key(name)[0]).module)
+        plugin = registry.get(kind, registry.config_key(name)[0])
+        return plugin_code_hash(plugin, plugin.params())
+
+    def simulation_code(self, solver, run_id):
+        """Return the code hash of one simulation's job: its solver and the parts its parameters choose."""
+        plugin = registry.get("solver", registry.config_key(solver)[0])
+        params = parse_params(plugin.params, self.simulation(solver, run_id).params, owner=f"solver '{solver}'")
+        return plugin_code_hash(plugin, params)
 
     @staticmethod
     def module(kind, name):

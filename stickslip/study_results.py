@@ -11,15 +11,21 @@ typed and carry their units (:mod:`stickslip.vocabulary`); its filters are those
 
 import dataclasses
 import re
+import shutil
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from . import registry
 from .errors import RunNotFoundError, StudyNotFoundError
 from .h5io import FileFormatError
+from .hashing import sha256_file
+from .output_safety.atomic import atomic_output
+from .plugin_params import ParameterError
 from .provenance import query
 from .provenance.filters import EVENT_FILTERS, RUN_FILTERS, with_filters
+from .provenance.record import record_path, write_record
 from .runs import open_run
 from .study_plan import PATHS, RESULTS, study_name
 from .workdir import ENVIRONMENT, find_workdir
@@ -133,31 +139,38 @@ class StudyResults:
         return f"<StudyResults {self.name!r}: {self.root}, config {self.config_file}>"
 
     @with_filters(RUN_FILTERS)
-    def runs(self, **filters):
+    def runs(self, *, wide=False, **filters):
         """The study's runs with their parameters (:func:`stickslip.provenance.query.runs`; ``stickslip db runs``).
 
         Parameters
         ----------
+        wide : bool, optional
+            Every column: the provenance record's (``code_hash``, ``host``, library versions, ``record_path``, ...)
+            and ``params.<name>``, one per parameter of the runs' plugins (about a hundred in a study with every
+            plugin). Default: the narrow form, :data:`stickslip.provenance.query.RUN_COLUMNS`.
         {filters}
         **parameters
             Any parameter of a plugin, e.g. ``backend="cpu"`` (:func:`stickslip.params`).
 
         Returns
         -------
-        pandas.DataFrame
-            One row per run (solver, analysis, figure, mesh): typed columns, the simulation's parameters
-            (``solver``, ``n``, ``plates``, ``blocks``, ``k_drive``, ``phi``, ``regime``, ...; missing for
-            other runs), ``started_at`` and ``finished_at`` as UTC datetimes, and ``params.<name>``, one column
-            per plugin parameter; ``attrs["units"]`` maps every column to its unit.
+        stickslip.vocabulary.UnitFrame
+            One row per run (solver, analysis, figure, mesh): ``run_id``, ``kind``, ``plugin``,
+            ``plugin_version``, the simulation's parameters (``solver``, ``n``, ``plates``, ``blocks``, ``k_drive``,
+            ``phi``, ``regime``, ...; missing for other runs), ``seed``, its cost, ``finished_at`` (UTC) and
+            commit; typed, every missing value ``pd.NA``; ``attrs["units"]`` maps every column to its unit
+            (``params.<name>``: the plugin's).
 
         Raises
         ------
         stickslip.plugin_params.ParameterError
             A ``ValueError`` naming a filter that does not exist or a value that does not fit it.
         """
+        if not isinstance(wide, (bool, np.bool_)):
+            raise ParameterError(f"wide: expected True or False, got {wide!r}")
         frame = query.runs(self.database, **filters)
         frame.attrs["units"].update(_plugin_units(frame))
-        return frame
+        return frame if wide else frame[list(query.RUN_COLUMNS)]
 
     @with_filters(EVENT_FILTERS)
     def events(self, **filters):
@@ -269,6 +282,55 @@ class StudyResults:
         for run_id in dict.fromkeys(ids):
             with self.open_run(run_id) as run:
                 yield run
+
+    def add(self, run):
+        """Add a simulation made outside the workflow (:func:`stickslip.simulate`) to the study.
+
+        Its file and provenance record are copied to ``results/{study}/added/{solver}/{run_id}.h5`` (and
+        ``.provenance.json``, the path in it rewritten) and the record is ingested into the study's database, so that
+        :meth:`runs`, :meth:`open_run` and ``stickslip browse`` show it; the workflow's ``database`` rule ingests
+        every record under ``added/`` too, so the next ``snakemake`` keeps it. The study's analyses and figures
+        are those of its config: the run's own events are ``run.slip_events()``.
+
+        Parameters
+        ----------
+        run : stickslip.runs.FemRun or stickslip.runs.TimeseriesRun
+            A run with its provenance record beside its file (what :func:`stickslip.simulate` writes).
+
+        Returns
+        -------
+        str
+            The run id.
+
+        Raises
+        ------
+        stickslip.h5io.FileFormatError
+            If the run has no provenance record, or its file no longer has the sha256 the record states (it was
+            changed or resumed after the record was written), or the study holds another file under its run id.
+        """
+        record = run.provenance
+        if record is None:
+            raise FileFormatError(f"{run.path}: no provenance record beside it ({record_path(run.path).name}); "
+                                  "a run made by stickslip.simulate or `stickslip simulate` has one")
+        output = record["outputs"][0]
+        sha256 = sha256_file(run.path)
+        if output["sha256"] != sha256:
+            raise FileFormatError(f"{run.path}: sha256 {sha256[:16]}... is not the {output['sha256'][:16]}... of its "
+                                  f"record {record_path(run.path)}: the file changed after the record was written")
+        target = self.root / PATHS["added"].format(solver=record["plugin"], run_id=record["run_id"])
+        if target.is_file() and sha256_file(target) != sha256:
+            raise FileFormatError(f"{target}: the study holds another file of run {record['run_id']}")
+        if not target.is_file():
+            target.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_output(target) as partial:
+                shutil.copyfile(run.path, partial)
+        relative = target.relative_to(self.root.parent.parent).as_posix()
+        added = {**record, "outputs": [{**output, "path": relative}, *record["outputs"][1:]]}
+        write_record(record_path(target), added)
+        from .provenance.ingest import ingest  # SQLAlchemy's ORM (~0.3 s): only where a record is ingested
+
+        ingest(self.database, [record_path(target)])
+        return record["run_id"]
 
     @with_filters(RUN_FILTERS[2:])
     def find(self, **filters):

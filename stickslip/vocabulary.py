@@ -27,8 +27,8 @@ import re
 import numpy as np
 import pandas as pd
 
-__all__ = ["Quantity", "QUANTITIES", "PATTERNS", "RENAMED", "quantity", "unit", "units", "with_units",
-           "dtype_matches", "typed", "expand_json"]
+__all__ = ["Quantity", "QUANTITIES", "PATTERNS", "RENAMED", "UnitFrame", "quantity", "unit", "units", "with_units",
+           "dtype_matches", "typed", "missing_as_na", "expand_json"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,7 +65,7 @@ QUANTITIES = {
                               "class (initial, load, micro, single, multi) or a sequence's (single, multi)"),
     "plugin": _q("str", _LABEL, "the plugin that ran"),
     "plugin_version": _q("str", _LABEL, "the plugin's algorithm version"),
-    "code_hash": _q("str", _ID, "hash of the package sources the plugin imports"),
+    "code_hash": _q("str", _ID, "hash of the code the job ran: its plugin, what it imports, the parts it chose"),
     "package_version": _q("str", _LABEL, "the stickslip version that ran"),
     "git_commit": _q("str", _ID, "the git commit of the code (missing outside a git tree)"),
     "git_dirty": _q("bool", _LABEL, "tracked files differed from the commit"),
@@ -326,21 +326,93 @@ def dtype_matches(dtype, expected):
     return bool(kind(dtype))
 
 
+def _column_units(columns, inputs, method):
+    """The unit of each of ``columns`` (the result of a pandas operation on ``inputs``) from the inputs' units.
+
+    A column keeps the unit it had in the input it came from: by its name, or, for a merge's columns renamed with
+    a suffix, by the name it had there (the left input's columns come first, in their order); a column that the
+    inputs give different units (a concat of two tables that disagree) has none (None); a column no input knows
+    (a new one) has the vocabulary's unit of its name.
+    """
+    tables = [obj.attrs.get("units") or {} for obj in inputs]
+    found = {}
+    if method == "merge" and len(inputs) == 2:  # the left table's columns first, in order, some with a suffix
+        for name, source in zip(map(str, columns), map(str, inputs[0].columns)):
+            if name.startswith(source) and source in tables[0]:
+                found[name] = tables[0][source]
+    for name in map(str, columns):
+        if name in found:
+            continue
+        given = {table[name] for table in tables if name in table}
+        if not given:  # a merge's suffixed column of the right table: its longest name that starts this one
+            stems = sorted((source for table in tables[::-1] for source in table
+                            if name.startswith(source) and name != source), key=len, reverse=True)
+            given = {next(table[stems[0]] for table in tables[::-1] if stems[0] in table)} if stems else set()
+        found[name] = given.pop() if len(given) == 1 else None if given else unit(name)
+    return found
+
+
+class UnitFrame(pd.DataFrame):
+    """A pandas DataFrame whose ``attrs["units"]`` (column -> unit) follows its columns through pandas' operations.
+
+    Every table of the package's API is one. pandas keeps ``attrs`` through an operation on one table, and drops
+    them in a ``merge``, ``join`` or ``concat`` of tables whose ``attrs`` differ; here each column of the result
+    keeps the unit of the column it came from (:func:`_column_units`), so ``runs.merge(events, ...)`` and
+    ``pd.concat([fem_events, lab_events])`` carry the units of all their columns, and a renamed column keeps its
+    unit. The data and dtypes are pandas'
+    own (plain float64, Int64, ...): no unit-aware arithmetic (pint-pandas) and no other array library (xarray).
+    The result of a merge or concat is a ``UnitFrame`` where the left or first table is one.
+    """
+
+    _metadata = []
+
+    @property
+    def _constructor(self):
+        return UnitFrame
+
+    def __finalize__(self, other, method=None, **kwargs):
+        super().__finalize__(other, method, **kwargs)
+        inputs = getattr(other, "input_objs", None) or ([other] if isinstance(other, pd.DataFrame) else [])
+        inputs = [obj for obj in inputs if isinstance(obj, (pd.DataFrame, pd.Series))]
+        if any("units" in obj.attrs for obj in inputs):
+            self.attrs["units"] = _column_units(self.columns, inputs, method)
+        return self
+
+    def __setitem__(self, key, value):
+        """pandas' ``frame[key] = value``; a new column gets the vocabulary's unit of its name (None if unknown)."""
+        super().__setitem__(key, value)
+        units = self.attrs.get("units")
+        if units is not None:
+            for name in map(str, self.columns):
+                units.setdefault(name, unit(name))
+
+    def rename(self, *args, **kwargs):
+        """pandas' ``rename``; a renamed column keeps its unit."""
+        columns, units = list(self.columns), dict(self.attrs.get("units", {}))
+        result = super().rename(*args, **kwargs)
+        renamed = self if result is None else result  # inplace=True
+        if units and len(renamed.columns) == len(columns):
+            renamed.attrs["units"] = {str(new): units.get(str(old), unit(new))
+                                      for old, new in zip(columns, renamed.columns)}
+        return result
+
+
 def with_units(frame, extra=None):
-    """``frame`` with ``attrs["units"]``: the unit of every column (the vocabulary's; ``extra`` first).
+    """``frame`` as a :class:`UnitFrame` with ``attrs["units"]``: every column's unit (the vocabulary's; ``extra`` first).
 
     Parameters
     ----------
     frame : pandas.DataFrame
-        Changed in place and returned.
+        Returned if a UnitFrame already (its units set), else a UnitFrame of the same data.
     extra : Mapping[str, str], optional
         Units of columns outside the vocabulary (a plugin's parameters).
 
     Returns
     -------
-    pandas.DataFrame
+    UnitFrame
     """
     extra = dict(extra or {})
+    frame = frame if isinstance(frame, UnitFrame) else UnitFrame(frame)
     frame.attrs["units"] = {str(c): extra[c] if c in extra else unit(c) for c in frame.columns}
     return frame
 
@@ -396,6 +468,36 @@ def typed(frame):
         found = quantity(column)
         if found is not None and not dtype_matches(frame[column].dtype, found.dtype):
             frame[column] = _cast(frame[column], found.dtype)
+    return frame
+
+
+#: The nullable dtype of a column with missing values, by its values' kind (numpy's dtype.kind).
+_NULLABLE = {"f": "Float64", "i": "Int64", "u": "Int64", "b": "boolean"}
+
+
+def missing_as_na(frame):
+    """``frame`` with one spelling of a missing value, ``pd.NA``, in every column that has one.
+
+    A column with missing values takes pandas' nullable dtype (``Float64``, ``Int64``, ``boolean``; text:
+    ``string``), whose missing value is ``pd.NA`` (``pd.isna``; ``to_numpy()`` gives NaN in a float array);
+    other columns (lists, mixed values) keep their dtype with ``pd.NA`` for ``None`` and NaN; datetimes keep
+    ``NaT``, pandas' missing datetime. Columns without missing values are left as they are. ``frame`` (a
+    pandas DataFrame) is changed in place and returned.
+    """
+    for column in frame.columns:
+        values = frame[column]
+        missing = values.isna()
+        if not missing.any() or isinstance(values.dtype, pd.DatetimeTZDtype) or values.dtype.kind == "M":
+            continue
+        if isinstance(values.dtype, pd.api.extensions.ExtensionDtype) and values.dtype.na_value is pd.NA:
+            continue  # Int64, boolean, Float64, string already
+        present = values[~missing]
+        if values.dtype.kind in _NULLABLE:
+            frame[column] = values.astype(_NULLABLE[values.dtype.kind])
+        elif pd.api.types.is_string_dtype(values.dtype) and all(isinstance(v, str) for v in present):
+            frame[column] = values.astype("string")
+        else:
+            frame[column] = values.astype(object).where(~missing, pd.NA)
     return frame
 
 

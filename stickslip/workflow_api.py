@@ -41,12 +41,12 @@ from .hashing import sha256_file
 from .lineage import Artifact
 from .output_safety.overwrite import refuse_other_run
 from .plugin_params import params_to_dict, parse_params
-from .provenance.code import code_hash
+from .provenance.code import code_hash, plugin_code_hash
 from .provenance.record import read_record, recording
 from .termination import interrupts_raised
 
 __all__ = ["prepare_environment", "partial_path", "kept_record", "run_mesh", "run_simulation", "run_analysis",
-           "run_figure", "build_database", "release_completed"]
+           "run_figure", "build_database", "build_browse", "release_completed"]
 
 #: What a job says about an existing output of another run (jobs have no ``--overwrite``).
 _NOT_THIS_JOBS = "it is not this job's output: move it away (or delete it) and rerun"
@@ -135,7 +135,7 @@ def _plugin_recording(record, outputs, plugin, params, run_id, *, code=None, **e
     """
     _refuse_other_outputs([path for _, path, *_ in outputs], record, run_id)
     return recording(record, outputs, run_id=run_id, kind=plugin.kind, plugin=plugin.name,
-                     plugin_version=plugin.version, code_hash=code or code_hash(plugin.module),
+                     plugin_version=plugin.version, code_hash=code or plugin_code_hash(plugin, params),
                      params=params_to_dict(params), **extra)
 
 
@@ -259,7 +259,7 @@ def _solver_job(solver, params_json, output, record, inputs, module):
     plugin, params = _load("solver", solver, params_json, module)
     if plugin.preflight is not None:  # e.g. a GPU backend without a GPU: said before any file is touched
         plugin.preflight(params)
-    run_id, code = registry.run_id(plugin, params), code_hash(plugin.module)
+    run_id, code = registry.run_id(plugin, params), plugin_code_hash(plugin, params)
     output, partial = Path(output), partial_path(output)
     _refuse_other_outputs([output], record, run_id)
     if _completed_before(partial, run_id, code):
@@ -476,3 +476,21 @@ def build_database(records, database, log):
 
         counts = ingest(database, records, rebuild=True)
         print("ingested " + ", ".join(f"{count} {name}" for name, count in counts.items()))
+
+
+def build_browse(study, output, log):
+    """Write a study's pages as a static site (the browse rule; :func:`stickslip.browse.site.build_site`).
+
+    Parameters
+    ----------
+    study : str
+        The study's name (its results tree ``results/{study}`` in the working directory, the workflow's).
+    output : str or pathlib.Path
+        The site's folder.
+    log : str or pathlib.Path
+    """
+    with _logged(log):
+        from .browse.site import build_site  # matplotlib and the database layer: for this job only
+        from .study_results import StudyResults
+
+        print(build_site(StudyResults(study, workdir="."), output, progress=print))

@@ -87,7 +87,8 @@ def numba_threads_variable():
 
 
 #: Test modules that share a costly session fixture, by the fixture: pytest-xdist runs each set in one worker.
-SHARED = {"ci_study": ("test_workflow_smoke", "test_slurm", "test_docs_queries", "test_tutorial", "test_study_api"),
+SHARED = {"ci_study": ("test_workflow_smoke", "test_slurm", "test_docs_queries", "test_tutorial", "test_study_api",
+                       "test_browse", "test_api_frictions"),
           "fem_reference_run": ("test_fem_reference", "test_fem_kill")}
 
 

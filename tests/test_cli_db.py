@@ -8,6 +8,7 @@ import subprocess
 import sys
 import time
 from contextlib import redirect_stdout
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -46,6 +47,21 @@ def test_db_commands(toy_results, capsys):
     assert status == 2 and "only reads" in capsys.readouterr().err
     status, _ = _run("db", "runs", "--db", "nowhere.sqlite")
     assert status == 2 and "nowhere.sqlite: no such database" in capsys.readouterr().err
+
+
+def test_db_options_before_or_after_the_sub_command(toy_results, tmp_path, monkeypatch):
+    """``--workdir``, ``--study`` and ``--db`` work before the sub-command (``db --workdir DIR runs``) and after it,
+    and after it they win."""
+    _run("db", "rebuild")
+    workflow = Path.cwd()
+    (workflow / "Snakefile").write_text("")
+    monkeypatch.chdir(tmp_path)  # no Snakefile at or above
+    after = _run("db", "runs", "--workdir", str(workflow), "--format", "csv")
+    before = _run("db", "--workdir", str(workflow), "runs", "--format", "csv")
+    assert after == before and after[0] == 0 and len(pd.read_csv(io.StringIO(after[1]))) == 5
+    assert _run("db", "--workdir", str(tmp_path), "runs", "--workdir", str(workflow), "--format", "csv") == after
+    assert _run("db", "--study", "default", "--workdir", str(workflow), "events", "--seed", "2")[0] == 0
+    assert _run("db", "--db", str(workflow / "results" / "default" / "stickslip.sqlite"), "runs")[0] == 0
 
 
 def test_db_sql_only_reads(toy_results, capsys, tmp_path):
@@ -148,3 +164,21 @@ def test_a_mistyped_regime_is_refused_not_answered_with_no_rows(toy_results, cap
             _run("db", command, "--regime", "complaint")
         assert exited.value.code == 2
         assert "invalid choice: 'complaint' (choose from 'stiff', 'compliant')" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("damage", ["not a database", "cut short"])
+def test_ingest_into_a_damaged_database_is_one_line_and_leaves_it(toy_results, capsys, tmp_path, damage):
+    # the audit of 575c37a (issue 59, item 4): a sqlalchemy DatabaseError traceback
+    assert _run("db", "rebuild")[0] == 0
+    database = tmp_path / "results" / "default" / "stickslip.sqlite"
+    if damage == "cut short":
+        database.write_bytes(database.read_bytes()[:3000])
+    else:
+        database.write_bytes(os.urandom(5000))
+    before = database.read_bytes()
+    capsys.readouterr()
+    assert _run("db", "ingest", "--db", str(database), *map(str, toy_results))[0] == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"stickslip: error: {database}: not a readable SQLite database (")
+    assert error.count("\n") == 1
+    assert "`stickslip db rebuild` remakes it" in error and database.read_bytes() == before

@@ -110,3 +110,31 @@ def test_a_semicolon_separated_file_gets_a_hint(tmp_path):
     with pytest.raises(FileFormatError, match=r"force.csv: one column whose header 't \[s\];F \[N\]' holds ';': the "
                                               r"file seems separated by ';'"):
         import_csv(force, force, tmp_path / "run.h5", n=1)
+
+
+def test_a_header_of_100000_unexpected_columns_is_one_short_line(tmp_path, capsys):
+    # the audit of 575c37a (issue 59, item 8): one error line of 789 kB
+    header = "t [s],F [N]," + ",".join(f"c{i} [N]" for i in range(100_000))
+    force, positions = write(tmp_path, force=header + "\n0,1\n0.02,1\n")
+    assert main(["import-csv", "--force", str(force), "--positions", str(positions), "--n", "1", "--n-slabs", "2",
+                 "-o", str(tmp_path / "lab.h5")]) == 2
+    error = capsys.readouterr().err
+    assert error == (f"stickslip: error: {force}: unexpected columns c0, c1, c2, c3, c4, c5, c6, c7 and 99992 more; "
+                     "expected exactly t, F\n")
+
+
+def test_forces_beyond_what_the_springs_hold_are_warned_and_beyond_a_double_refused(tmp_path, capsys):
+    # the audit of 575c37a (issue 59, item 7): forces of +-1e308 N were imported without a word
+    rows = "\n".join(f"{0.02 * i:.2f},{value}" for i, value in enumerate([2.5, 1e308, -1e308, 2.6, 2.7]))
+    force, positions = write(tmp_path, force="t [s],F [N]\n" + rows + "\n")
+    args = ["import-csv", "--force", str(force), "--positions", str(positions), "--n", "1", "--n-slabs", "2",
+            "-o", str(tmp_path / "lab.h5")]
+    assert main(args) == 0
+    warnings = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert warnings == [f"stickslip: warning: {force}: the lever force reaches 1e+308 N, 1e+307 times the 9.8 N its "
+                        "springs can hold (each at most the friction of the 2 interfaces at N = 49 N, on its arm j h / "
+                        "H); check the units and the apparatus attributes"]
+    force.write_text("t [s],F [kN]\n" + rows + "\n")
+    assert main(args + ["--overwrite"]) == 2
+    assert capsys.readouterr().err == (f"stickslip: error: {force}: line 3, column 'F': 1e+308 times 1000 (to N) is "
+                                       "beyond the range of a double\n")

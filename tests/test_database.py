@@ -57,6 +57,26 @@ def test_ingest_fills_every_table_from_records(toy_results):
         SCHEMA_VERSION)
 
 
+def test_runs_show_a_parameter_that_a_record_leaves_out_at_its_default(toy_results):
+    """A record made before a parameter existed (or leaving an extension at its default out): runs() shows the
+    default, not a missing value; a record of another code-hash scheme ingests as any (it is a text)."""
+    import json
+
+    database = "results/default/stickslip.sqlite"
+    solver = next(path for path in toy_results if "/sim/" in path.as_posix())
+    record = json.loads(solver.read_text())
+    del record["params"]["disorder"]  # as a run made before the parameter existed records it
+    record["code_hash"] = "an older scheme"
+    solver.write_text(json.dumps(record))
+    ingest(database, find_records("results/default"), rebuild=True)
+    runs = query.runs(database, kind="solver").set_index("run_id")
+    assert runs.loc[record["run_id"], "params.disorder"] == 0.2  # BlockParams' default
+    assert runs.loc[record["run_id"], "code_hash"] == "an older scheme"
+    assert runs["params.disorder"].notna().all() and sorted(runs["params.seed"]) == [1, 2]
+    stored = query.sql(f"SELECT params FROM runs WHERE run_id = '{record['run_id']}'", database)
+    assert "disorder" not in json.loads(stored["params"].iloc[0])  # the database keeps the record as it is
+
+
 def test_ingest_is_idempotent_and_rebuild_matches(toy_results):
     database = "results/default/stickslip.sqlite"
     ingest(database, toy_results)

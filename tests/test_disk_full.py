@@ -172,4 +172,4 @@ def test_a_fem_run_stops_cleanly_before_the_disk_is_full_and_resumes_to_the_same
         filler.unlink()
         assert stickslip(fem + ["-o", str(output)]).returncode == 0
         assert digest(output) == digest(reference)
-        assert sorted(p.name for p in disk.iterdir()) == ["run.h5"]
+        assert sorted(p.name for p in disk.iterdir()) == ["run.h5", "run.provenance.json"]

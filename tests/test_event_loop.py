@@ -55,19 +55,19 @@ def test_the_docs_event_source_composed_into_the_thermal_protocol_makes_the_athe
     slips = 0
     for increment in range(1, 31):
         event = increment % 2 == 0
-        assert athermal.protocol.step(event, 5, increment) is not None
+        assert athermal.protocol.step(5, increment)["kick"] == event  # each protocol knows what comes next
         before = thermal.stack.stored()
-        row = protocol.step(event, 5, increment)
-        assert row["hop_block"] == -1 and row["failed_hops"] == 0
+        row = protocol.step(5, increment)
+        assert row["kick"] == event and row["hop_block"] == -1 and row["failed_hops"] == 0
         after = thermal.stack.stored()
-        assert np.array_equal(after[0], athermal.stack.read("u")[0])  # the athermal state, bit for bit
-        assert np.array_equal(after[1], athermal.stack.read("target")[0])
-        elapsed = after[3] - before[3]
+        assert np.array_equal(after.u, athermal.stack.read("u")[0])  # the athermal state, bit for bit
+        assert np.array_equal(after.target, athermal.stack.read("target")[0])
+        elapsed = after.t - before.t
         if event:
             slips += 1
             assert elapsed == 0.0  # avalanches take no time
         else:  # the drive offset to the brink at the drive's speed
-            offset = (after[1][-1] - before[1][-1]) / scale
+            offset = (after.target[-1] - before.target[-1]) / scale
             assert elapsed == pytest.approx(offset / protocol.speed, rel=1e-12)
             assert elapsed > 0.0
     assert slips == 15
@@ -80,14 +80,14 @@ def test_relaxations_leave_a_protocol_clock_alone_and_it_never_goes_back():
     clock.advance_to(2.5)
     sim.loading.step(False)
     assert sim.protocol.kick(5)[0]  # a whole avalanche: the backend's dynamics ran, the clock did not
-    assert stack.time == 2.5 and stack.stored()[3] == 2.5
+    assert stack.time == 2.5 and stack.stored().t == 2.5
     with pytest.raises(ValueError, match="cannot go back"):
         clock.advance_to(1.0)
     with pytest.raises(ValueError, match="cannot go back"):
         Clock(3.0).advance_to(2.999)
     state = stack.stored()
     clock.advance_to(7.0)
-    stack.restore(*state)  # a restore sets the stored state's time with the rest of it
+    stack.restore(state)  # a restore sets the stored state's time with the rest of it
     assert stack.time == 2.5
     athermal = _simulation()
     athermal.loading.step(False)

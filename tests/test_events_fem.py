@@ -1,15 +1,10 @@
 """The event analyses on a real (small) fem run: consistency with the solver's own counts."""
 
-import importlib.util
-import re
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from stickslip import registry
 from stickslip.events.analysis_files import read_analysis_file
-from stickslip.formats.event_table import read_slip_events
 from stickslip.formats.fem_run import read_increments
 from stickslip.lineage import Artifact
 from stickslip.plugin_params import parse_params
@@ -66,36 +61,3 @@ def test_front_dynamics_reruns_reproduce_the_stored_counts(fem_run, tmp_path):
             assert (hops != 0).sum() == raw.loc[increment, f"A_a{a}"]  # blocks in another well
     assert (fronts["s"] >= 1).all()
     assert np.isclose(result.attrs["interface_spacing"], 3 * np.pi)  # N = 18: a 2-block plate + 1 block
-
-
-def _doc_module(name, block):
-    """Import the ``block``-th Python example of docs/developing.md as the package module ``name``."""
-    text = (Path(__file__).resolve().parent.parent / "docs" / "developing.md").read_text()
-    source = re.findall(r"```python\n(.*?)```", text, re.S)[block]
-    spec = importlib.util.spec_from_loader(name, loader=None)
-    module = importlib.util.module_from_spec(spec)
-    module.__package__ = name.rpartition(".")[0]
-    exec(compile(source, f"docs/developing.md[{block}]", "exec"), module.__dict__)
-    return module
-
-
-def test_worked_example_of_the_developers_guide_runs(fem_run, tmp_path):
-    """docs/developing.md: a new analysis and its figure in new modules only, on a real fem run."""
-    analysis_module = _doc_module("stickslip.events.largest", 0)
-    figure_module = _doc_module("stickslip.figures.figs_largest", 1)
-    params = parse_params(analysis_module.LargestParams, {"count": 2})
-    analysis_module.run(params, fem_run, tmp_path / "largest.h5")
-    largest = read_slip_events(tmp_path / "largest.h5")
-    everything = read_slip_events_of_run(fem_run, tmp_path)
-    for a, rows in largest.groupby("interface"):
-        expected = everything[everything["interface"] == a]["dmu_sig0"].nlargest(2)
-        np.testing.assert_array_equal(np.sort(rows["dmu_sig0"].to_numpy()), np.sort(expected.to_numpy()))
-    item = Artifact(tmp_path / "largest.h5", "0" * 16, "largest-slips", "event-table", fem_run)
-    figure_module.run(figure_module.LargestFigureParams(), {"analysis:largest-slips": [item]}, tmp_path / "f.pdf")
-    assert (tmp_path / "f.pdf").stat().st_size > 1000 and (tmp_path / "f.png").stat().st_size > 1000
-
-
-def read_slip_events_of_run(fem_run, tmp_path):
-    analysis = registry.get("analysis", "numerical-events")
-    analysis.run(parse_params(analysis.params, {}), fem_run, tmp_path / "all.h5")
-    return read_slip_events(tmp_path / "all.h5")

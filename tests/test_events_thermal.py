@@ -208,7 +208,7 @@ def test_an_elastic_unload_stops_at_the_first_block_that_would_leave_its_well(st
     capped = 0
     for increment in increments["increment"].to_numpy()[increments["kick"].to_numpy()][:20]:
         state = replay._state(int(increment))
-        simulation.stack.restore(*state)
+        simulation.stack.restore(state)
         wells = simulation.stack.well_index()
         wanted = 100.0 * simulation.loading.step_size(False) + 1.0
         unload = simulation.loading.unload_size(wanted)
@@ -217,7 +217,7 @@ def test_an_elastic_unload_stops_at_the_first_block_that_would_leave_its_well(st
         assert np.array_equal(simulation.stack.well_index(), wells)
         if unload < wanted:
             capped += 1
-            simulation.stack.restore(*state)
+            simulation.stack.restore(state)
             simulation.loading.load(-unload * (1.0 + 1e-4))
             assert not np.array_equal(simulation.stack.well_index(), wells)
     assert capped > 0
@@ -231,7 +231,7 @@ def test_a_hold_unloads_a_state_nearer_its_threshold_than_below(study):
     simulation = replay.simulation
     slips = _tables(study[figs_thermal.THERMAL][0])["slip_events"]
     state = int(slips["increment"].iloc[len(slips) // 2])
-    simulation.stack.restore(*replay._state(state))
+    simulation.stack.restore(replay._state(state))
     scale = drive_scale(simulation.loading.response, simulation.params.eps0, simulation.mesh)
     near = simulation.loading.step_size(False) * scale
     assert simulation.loading.unload_size(0.5 / scale) == 0.5 / scale  # the unloads below are not capped

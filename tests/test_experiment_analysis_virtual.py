@@ -80,7 +80,7 @@ def test_every_slip_found_with_its_interface_and_amplitudes(stack_run):
 
 
 def test_individual_protocol_amplitudes(tmp_path):
-    path = _simulate(tmp_path, "ind", protocol="individual", a=2, seed=3, duration=3000.0)
+    path = _simulate(tmp_path, "ind", protocol="individual", driven_slab=2, seed=3, duration=3000.0)
     slips, _, truth, found = _match(path)
     assert np.all(found >= 0) and len(slips) == len(truth) > 5
     matched = slips.iloc[found].reset_index(drop=True)

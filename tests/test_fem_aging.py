@@ -244,8 +244,8 @@ def test_every_event_renews_the_junctions_of_the_blocks_that_changed_well(aging_
         previous = None
         for increment in range(run.nstored):
             state = run.state(increment)
-            junctions = state[4]
-            stack.restore(*state)
+            junctions = state.further
+            stack.restore(state)
             wells = stack.well_index()
             whole = np.all(wells == wells[:, :1], axis=1)
             assert np.array_equal(junctions["junction_well"], np.where(whole, wells[:, 0], -1))

@@ -28,7 +28,7 @@ def test_both_backends_run_the_same_events(relaxation):
     other = Simulation(params, mesh, make_backend("assembled"), response=reference.loading.response)
     slips = 0
     for event in range(12):
-        other.stack.restore(*reference.stack.stored())  # the same state before every event
+        other.stack.restore(reference.stack.stored())  # the same state before every event
         before = reference.stack.well_index()
         for sim in (reference, other):
             sim.loading.step(False)

@@ -6,7 +6,8 @@ thread, a time step of an N = 9 stack in ~0.1-0.3 s: the checks are short sequen
 ``structured`` CPU backend from the same state (states within round-off, wells and statuses equal):
 the force evaluation (fixed and free lever), time steps after a kick, a minimisation stopped by each of
 its criteria (step limit, quiet window, residual, margin) with the recorded well changes, the exact
-relaxation's direct solve, a thermal increment, and a batch of three realisations whose every member
+relaxation's direct solve, a thermal increment, a checkpoint (the changes of well since it counted on the device,
+the rollback across a change of the held yield strains), and a batch of three realisations whose every member
 equals the same realisation run alone, bit for bit. The simulator checks no types: every kernel is also
 compiled to PTX for sm_90 (the H100) with numba-cuda's NVVM. Skipped without numba-cuda (failed instead
 where ``STICKSLIP_REQUIRE_CUDA_TOOLS`` is set, as .ci/run does); the checks that need a real GPU are in
@@ -43,6 +44,7 @@ PRELUDE = """
     from stickslip.mesh import MeshParams, build_stack_mesh
 
     FIELDS = ("u", "v", "a", "f", "eps", "sig", "ubar", "target", "lever", "t")
+    CHECKED = ("u", "v", "a", "f", "idx", "eps", "sig", "ubar", "target", "lever", "t")
 
     def pair(**values):
         values = {"N": 9, "plates": 2, "seed": 1, "k_drive": 1e-3, "dt_scale": 4.0, **values}
@@ -74,28 +76,55 @@ def _close(differences, tolerance=ROUND_OFF):
     assert all(value < tolerance for value in differences.values()), differences
 
 
-def test_every_kernel_compiles_for_sm_90_with_one_grid_barrier_per_step_and_no_floating_point_atomics(numba_cuda):
-    # every kernel for the cusp law; the law's own for the smooth law (the others do not depend on it)
+def test_every_kernel_compiles_for_sm_90_with_one_grid_barrier_per_step_no_spills_and_no_floating_point_atomics(
+        numba_cuda):
+    # every kernel for the cusp law; the law's own for the smooth law (the others do not depend on it); compiled to
+    # PTX by NVVM, then to machine code by ptxas (nvJitLink) under the launch's register cap
     result = _run("""
-    from stickslip.fem.backends.cuda.compile import KERNELS, ptx, ptx_figures
+    from stickslip.fem.backends.cuda.compile import KERNELS, kernel_figures
     from stickslip.fem.constants import derived_constants
     from stickslip.fem.stack import stack_model
     out = {}
-    for law, kernels in (("cusp", KERNELS), ("smooth", ("minimise", "evaluate"))):
+    for law, kernels in (("cusp", KERNELS), ("smooth", ("minimise", "resident", "evaluate"))):
         params = FemParams(N=9, plates=2, nchunk=30, interface_law=law)
         mesh = build_stack_mesh(MeshParams(N=9, plates=2))
         model, _ = stack_model(params, mesh, derived_constants(params, mesh))
-        for name, text in ptx(model, mesh, kernels=kernels).items():
-            out[f"{law}:{name}"] = ptx_figures(text)
+        for name, figures in kernel_figures(model, mesh, kernels).items():
+            out[f"{law}:{name}"] = figures
     print(json.dumps(out))
     """, simulator=False)
-    assert len(result) == 13
+    from stickslip.fem.backends.cuda.kernels import MAX_REGISTERS
+
+    assert len(result) == 15
+    minimisers = ("minimise", "resident")
     for name, figures in result.items():
         assert figures["target"] == "sm_90", name
         assert figures["float_atomics"] == [], name  # no atom. or red. on .f16/.f32/.f64
         assert figures["shared_bytes"] <= 48 * 1024, name  # static shared memory of one block
-        # the minimisation kernel's one barrier site sits in its time-step loop; no other kernel has one
-        assert figures["grid_barriers"] == (1 if name.endswith(":minimise") else 0), name
+        # the minimisation kernels' one barrier arrival sits in their time-step loop, its poll after it (the compiler
+        # may copy the poll's load); no other kernel has either
+        minimiser = name.split(":")[1] in minimisers
+        assert figures["grid_barriers"] == minimiser and (figures["barrier_spins"] > 0) == minimiser, name
+        # no spills, and the minimisation kernels under their cap
+        assert figures["spill_store_bytes"] == figures["spill_load_bytes"] == 0, (name, figures)
+        if minimiser:
+            assert figures["registers"] <= MAX_REGISTERS, (name, figures)
+    print({name: {k: figures[k] for k in ("registers", "stack_bytes", "block_barriers", "shared_bytes")}
+           for name, figures in result.items() if name.split(":")[1] in minimisers})
+
+
+def test_the_count_of_changed_wells_compiles_for_sm_90_with_integer_atomics_only(numba_cuda):
+    result = _run("""
+    import numba
+    from numba import cuda
+    from stickslip.fem.backends.cuda.changed_wells import count_changed
+    from stickslip.fem.backends.cuda.compile import ptx_figures
+    wells, rows = np.zeros((9, 4), np.int64), np.zeros(9, np.int64)
+    signature = tuple(numba.typeof(array) for array in (wells, wells, rows, rows, np.zeros(1, np.int64)))
+    text, _ = cuda.compile(count_changed.py_func, signature, device=False, cc=(9, 0), abi="numba", output="ptx")
+    print(json.dumps({**ptx_figures(text), "integer_atomics": text.count("atom.global.add.u64")}))
+    """, simulator=False)
+    assert result["target"] == "sm_90" and result["float_atomics"] == [] and result["integer_atomics"] == 1
 
 
 @pytest.fixture(scope="module")
@@ -144,13 +173,30 @@ def simulated(numba_cuda):
     for sim in (cpu, gpu):
         sim.loading.step(False)
         sim.loading.step(True)
-    ny = cpu.model.epsy.shape[1]
+    ny = cpu.stack.yield_strains.shape[1]
     out["margin"] = [sim.backend.minimise(1e-5, 20, 100, ny - 1, False, 0)[:2] for sim in (cpu, gpu)]
     # a thermal load increment (kinetic Monte Carlo on the host, the hop's relaxation on the device)
     cpu, gpu = pair(relaxation="exact", quiet_steps=3, temperature=2e-3, drive_rate=1e-5)
-    out["thermal"] = [[sim.protocol.step(False, 5, 1)] for sim in (cpu, gpu)]
+    out["thermal"] = [[sim.protocol.step(5, 1)] for sim in (cpu, gpu)]
     out["thermal_state"] = compare(cpu, gpu)
     out["thermal_wells"] = bool(np.array_equal(cpu.stack.well_index(), gpu.stack.well_index()))
+    # a checkpoint on the device: the changes of well since it counted there, and the rollback across a change of
+    # the held yield strains (the windows widened since)
+    cpu, gpu = pair()
+    out["checkpoint"] = []
+    for sim in (cpu, gpu):
+        stack = sim.stack
+        sim.loading.step(False)
+        token, ny, wells = stack.checkpoint(), stack.yield_strains.shape[1], stack.well_index()
+        kept = [array.tobytes().hex() for array in sim.backend.read(*CHECKED)]
+        sim.loading.step(True)
+        stack.widen_wells()
+        changed = [stack.changed_since(token), stack.changed_since(token, elements=np.arange(3)),
+                   int(np.count_nonzero(stack.well_index() != wells)),
+                   int(np.count_nonzero(stack.well_index()[:3] != wells[:3]))]
+        stack.rollback(token)
+        back = [array.tobytes().hex() for array in sim.backend.read(*CHECKED)]  # the backend's, not the stack's copies
+        out["checkpoint"].append(changed + [stack.changed_since(token), back == kept, stack.yield_strains.shape[1] == ny])
     # a batch of three realisations whose minimisations end at different launches, against each alone
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
     steps = {1: 3, 2: 5, 3: 2}
@@ -198,6 +244,14 @@ def test_a_thermal_increment_draws_the_same_event_on_the_device(simulated):
     differences = dict(simulated["thermal_state"])
     assert differences.pop("idx")
     assert all(value < 1e-9 for value in differences.values()), differences  # exact solves: tol^2 residuals
+
+
+def test_a_checkpoint_on_the_device_counts_the_changes_of_well_and_rolls_back_bit_for_bit(simulated):
+    cpu, gpu = simulated["checkpoint"]
+    assert cpu == gpu
+    changed, in_three, wells, wells_in_three, after, equal, width = gpu
+    assert changed == wells > 0 and in_three == wells_in_three
+    assert after == 0 and equal and width  # the yield strains held at the checkpoint held again
 
 
 def test_a_batch_member_equals_the_same_realisation_run_alone_bit_for_bit(simulated):
@@ -334,7 +388,7 @@ def test_an_ensemble_computes_a_linear_response_in_a_batch_of_the_elastic_law(nu
     params = FemParams(N=9, plates=2, nchunk=30)
     mesh = build_stack_mesh(MeshParams(N=9, plates=2))
     model, _ = stack_model(params, mesh, derived_constants(params, mesh))
-    elastic = model._replace(law=Elastic(*model.law), epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
+    elastic = model._replace(law=Elastic(*model.law))
     ensemble = Ensemble(1)
     cusp_batch, elastic_batch = ensemble.batch_for(model, mesh), ensemble.batch_for(elastic, mesh)
     try:

@@ -20,6 +20,7 @@ from stickslip.fem.quad4 import element_strain
 from stickslip.fem.random import pcg32_uint32, pcg32_uniform
 from stickslip.fem.simulation import Simulation
 from stickslip.fem.yield_strains import interface_initstate, yield_strains
+from stickslip.formats.fem_run import StoredState
 from stickslip.mesh import MeshParams, build_stack_mesh
 
 
@@ -56,8 +57,8 @@ def sim():
 
 def _drive_at_rest(sim, u):
     """Set displacement ``u`` with the drive springs at rest (targets at the layer averages)."""
-    sim.stack.restore(u, np.zeros(sim.mesh.nlayer), 0.0, 0.0)
-    sim.stack.restore(u, sim.backend.read("ubar")[0].copy(), 0.0, 0.0)
+    sim.stack.restore(StoredState(u, np.zeros(sim.mesh.nlayer), 0.0, 0.0))
+    sim.stack.restore(StoredState(u, sim.backend.read("ubar")[0].copy(), 0.0, 0.0))
     return sim.backend.read("f")[0]
 
 
@@ -98,7 +99,7 @@ def test_uniaxial_strain_gives_bulk_and_shear_energy(sim):
 def _undamped_energy_error(sim, dt, nsteps):
     model = sim.model._replace(damping=np.zeros(sim.model.ndof), dt=dt,
                                      drive_active=np.zeros_like(sim.model.drive_active))
-    backend = sim.backend.for_model(model)
+    backend = sim.backend.for_model(model, sim.stack.yield_strains)
     x, y = sim.mesh.coor[:, 0], sim.mesh.coor[:, 1]
     L, H = sim.mesh.N * sim.mesh.h, y.max()
     u = np.zeros(model.ndof)
@@ -142,9 +143,9 @@ def _column_mesh(nx, ny, h):
 def test_shear_pulse_travels_at_the_shear_wave_speed():
     h, nx, ny = np.pi, 4, 400
     mesh = _column_mesh(nx, ny, h)
-    model = build_model(mesh, epsy=np.zeros((0, 3)), law=Cusp(4.5, 1.0), rho=1.0, alpha=0.0, dt=0.05, k_drive=0.0,
+    model = build_model(mesh, law=Cusp(4.5, 1.0), rho=1.0, alpha=0.0, dt=0.05, k_drive=0.0,
                         drive_active=np.array([False]), free_lever=False, lever_height=1.0)
-    backend = make_backend().prepare(model, mesh)
+    backend = make_backend().prepare(model, mesh, np.zeros((0, 2)))  # no interface
     c_s = math.sqrt(1.0 / 2.0 / 1.0)
     y = mesh.coor[:, 1]
     y0, width = 100 * h, 12 * h
@@ -174,26 +175,26 @@ def test_linear_response_and_load_step_superpose(sim):
     backend = sim.backend
     r = compute_linear_response(stack, model, sim.relaxation, sim.params, sim.mesh)
     # the response is linear: forces scale with the displacement (interfaces in their first well)
-    stack.restore(3.0 * r.delta_u, 3.0 * r.delta_target, 0.0, 0.0)
+    stack.restore(StoredState(3.0 * r.delta_u, 3.0 * r.delta_target, 0.0, 0.0))
     f3 = backend.read("f")[0].copy()
-    stack.restore(r.delta_u, r.delta_target, 0.0, 0.0)
+    stack.restore(StoredState(r.delta_u, r.delta_target, 0.0, 0.0))
     f = backend.read("f")[0]
     np.testing.assert_allclose(f3, 3.0 * f, rtol=0, atol=1e-12 * np.abs(f3).max())
     # and it is in equilibrium with its drive (minimised to the residual tolerance)
     free = ~model.prescribed
     assert np.linalg.norm(f[free]) < 1e-3 * np.linalg.norm(f[~free])
     # the load step superposes strain and stops just short of the first yield strain
-    stack.restore(np.zeros(model.ndof), np.zeros(nlayer), 0.0, 0.0)
+    stack.restore(StoredState(np.zeros(model.ndof), np.zeros(nlayer), 0.0, 0.0))
     step = sim.loading.step(kick=False)
     u, eps, idx = backend.read("u", "eps", "idx")
     np.testing.assert_allclose(eps, step * r.delta_eps, rtol=0, atol=1e-12 * np.abs(eps).max())
     eq = np.hypot(0.5 * (eps[..., 0] - eps[..., 1]), eps[..., 2])
-    ratio = eq / model.epsy[:, 1][:, None]
+    ratio = eq / stack.yield_strains[:, 1][:, None]
     assert np.all(idx == 0)
     assert 1.0 - 2e-5 < ratio.max() < 1.0
     # a kick makes at least one Gauss point yield, and no more than a kick's worth of strain is added
     before = idx.copy()
-    kick = step_size(model.epsy, model.iface_dofs, model.iface_dNdx, u, r.delta_u, eps, r.delta_eps, before,
+    kick = step_size(stack.yield_strains, model.iface_dofs, model.iface_dNdx, u, r.delta_u, eps, r.delta_eps, before,
                      sim.constants["deps"], True, False)
     sim.loading.step(kick=True)
     assert np.any(backend.read("idx")[0] != before)
@@ -209,7 +210,7 @@ def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells
     # recompute path)
     backend = Simulation(FemParams(N=9, plates=3, nchunk=50, interface_law=law),
                          build_stack_mesh(MeshParams(N=9, plates=3)), make_backend()).backend
-    model, state = backend.model, new_state(backend.model)
+    model, state = backend.model, new_state(backend.model, backend.state.epsy)
     assert model.law.name == law
     rng = np.random.default_rng(3)
     state.u[:] = 2e-3 * rng.standard_normal(model.ndof)
@@ -225,10 +226,10 @@ def test_vectorised_interface_kernel_has_the_bits_of_the_scalar_law(update_wells
         for q in range(4):
             i = before[e, q]
             if update_wells:
-                i = well_index(model.epsy[e], equivalent_strain(*eps[q]), i)
+                i = well_index(state.epsy[e], equivalent_strain(*eps[q]), i)
             moved += i != before[e, q]
             assert state.idx[e, q] == i
-            sig = well_stress(model.law, *eps[q], model.epsy[e, i], model.epsy[e, i + 1])
+            sig = well_stress(model.law, *eps[q], state.epsy[e, i], state.epsy[e, i + 1])
             assert state.eps[e, q].tobytes() == eps[q].tobytes()
             assert state.sig[e, q].tobytes() == np.array(sig).tobytes()
             for m in range(4):

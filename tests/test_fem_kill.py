@@ -52,7 +52,7 @@ def test_killed_runs_resume_to_the_bytes_of_an_uninterrupted_run(fem_reference_r
     done = subprocess.run(_cli(output), capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert output.read_bytes() == fem_reference_run.read_bytes()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"]  # no lock or temporary file left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5", "run.provenance.json"]  # no lock or temporary file left
 
 
 def test_a_killed_workflow_job_resumes_to_the_same_bytes(fem_reference_run, tmp_path):

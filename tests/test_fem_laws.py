@@ -1,11 +1,16 @@
 """Verification of the interface laws (stickslip.fem.laws): energy, stress, continuity, barriers, runs."""
 
+import os
+import subprocess
+import sys
+from collections import namedtuple
+
 import numpy as np
 import pytest
 
 from stickslip.fem.backends import make_backend
 from stickslip.fem.laws import (INTERFACE_LAWS, LAWS, Cusp, Elastic, Smooth, backward_barrier, deviatoric_factor,
-                                energy_density, forward_barrier, well_energy, well_stress)
+                                energy_density, forward_barrier, register_law, well_energy, well_stress)
 from stickslip.fem.materials import elastic_stress
 from stickslip.fem.materials import equivalent_strain
 from stickslip.fem.parameters import FemParams
@@ -148,4 +153,56 @@ def test_the_event_driven_protocol_and_both_relaxations_run_with_the_smooth_law(
         assert v.max() == v.min() == 0.0
         scale = np.abs(u).max()
         assert np.abs(dynamic.backend.read("u")[0] - u).max() < 1e-3 * scale
-        dynamic.stack.restore(*exact.stack.stored())  # continue both from the same state
+        dynamic.stack.restore(exact.stack.stored())  # continue both from the same state
+
+
+def test_registering_refuses_a_law_parameter_without_a_default():
+    class Unfinished(namedtuple("Unfinished", ("K", "G", "c"))):
+        name = "test-unfinished"
+
+    with pytest.raises(ValueError, match=r"law 'test-unfinished': parameter\(s\) c without a default"):
+        register_law(Unfinished)
+    assert "test-unfinished" not in LAWS
+
+
+OTHER_PACKAGE = {
+    "other_laws.py": "from stickslip.fem.laws import Cusp, register_law\n\n\n@register_law\nclass OtherCusp(Cusp):\n"
+                     "    __slots__ = ()\n    name = 'other-cusp'\n",
+    "other_backends.py": "from stickslip.fem.backends import register_backend\nfrom stickslip.fem.backends.cpu import "
+                         "StructuredBackend\n\n\n@register_backend\nclass Other(StructuredBackend):\n"
+                         "    name = 'other'\n",
+}
+
+
+def _distribution(folder, entry_points, modules):
+    """A folder holding ``modules`` and an installed distribution whose entry points are ``entry_points``."""
+    folder.mkdir()
+    for name, text in modules.items():
+        (folder / name).write_text(text)
+    info = folder / "other-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: other\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(entry_points)
+    return folder
+
+
+def test_laws_and_backends_of_another_package_are_found_through_their_entry_points(tmp_path):
+    site = _distribution(tmp_path / "site", "[stickslip.fem.laws]\nother = other_laws\n\n"
+                         "[stickslip.fem.backends]\nother = other_backends\n", OTHER_PACKAGE)
+    script = ("from stickslip.fem.parameters import FemParams; from stickslip.plugin_params import parse_params; "
+              "from stickslip import registry; from stickslip.provenance.code import plugin_code_hash, module_sources; "
+              "fem = registry.get('solver', 'fem'); "
+              "params = parse_params(FemParams, {'interface_law': 'other-cusp', 'backend': 'other'}); "
+              "print([choice.module(params) for choice in fem.choices], len(plugin_code_hash(fem, params)))")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), *sys.path[1:]])}
+    done = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["['other_laws',", "'other_backends']", "16"]
+    broken = _distribution(tmp_path / "broken", "[stickslip.fem.laws]\nbroken = broken_law\n",
+                           {"broken_law.py": "raise ImportError('a missing dependency')\n"})
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(broken), *sys.path[1:]])}
+    done = subprocess.run([sys.executable, "-c", "import stickslip.fem.laws"], cwd=tmp_path, env=env,
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    assert ("entry point 'broken' in group 'stickslip.fem.laws' failed to load: a missing dependency"
+            in done.stderr.splitlines()[-1])

@@ -122,7 +122,7 @@ def _indices(path, increment):
         stack = Simulation(params, run.mesh, make_backend(params.backend), response=run.linear_response()).stack
         out = []
         for inc in (increment - 1, increment):
-            stack.restore(*run.state(inc))
+            stack.restore(run.state(inc))
             out.append(stack.well_index()[:, 0])
     return np.array(out)
 

@@ -69,7 +69,7 @@ def test_an_equilibrium_outside_the_current_wells_is_rejected_and_leaves_the_sta
     assert not sim.relaxation.solve_in_wells(backend)
     for name, value in zip(kept._fields, kept):  # state untouched, bit for bit
         assert backend.read(name)[0].tobytes() == value.tobytes(), name
-    sim.stack.restore(*before)
+    sim.stack.restore(before)
     assert sim.relaxation.solve_in_wells(backend)  # at the brink of yielding, in its wells: accepted
 
 

@@ -38,7 +38,7 @@ def _write(path, header=HEADER, increments=3):
 
 def _increment(i, ndof, nlayer):
     """The state and the row of increment ``i`` of the files written here."""
-    state = (np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i)
+    state = fem_run.StoredState(np.full(ndof, float(i)), np.full(nlayer, 2.0 * i), 3.0 * i, 0.1 * i)
     return state, {"increment": i, "kick": i % 2 == 0, "yield_element": False, "t": 0.1 * i, "sigd": 1.5 * i,
                    "S_a1": i, "A_a1": 9 * i}
 
@@ -58,9 +58,9 @@ def test_a_producer_with_other_parameters_writes_a_readable_file(tmp_path):
     with open_file(path) as file:
         run = fem_run.RunFile(file)
         assert run.params == HEADER["params"] and run.nstored == 3 and run.mesh.N == 9
-        u, target, lever, t = run.state(2)
-        np.testing.assert_array_equal(u, np.full(mesh.ndof, 2.0))
-        assert (lever, t) == (6.0, pytest.approx(0.2))
+        state = run.state(2)
+        np.testing.assert_array_equal(state.u, np.full(mesh.ndof, 2.0))
+        assert (state.lever_target, state.t) == (6.0, pytest.approx(0.2)) and not state.further
         stored = run.linear_response()
         for got, expected in zip(stored, response):
             np.testing.assert_array_equal(got, expected)
@@ -83,19 +83,19 @@ def test_a_producer_stores_further_state_per_increment_and_reads_it_back(tmp_pat
         fem_run.create_file(file, HEADER, mesh, response, ["t"], state_fields=fields)
         for i in range(3):
             further = {"depth": np.full(ni, 0.5 * i), "well": np.arange(ni) + i}
-            fem_run.append_increment(file, (np.zeros(ndof), np.zeros(nlayer), 0.0, 0.1 * i, further),
+            fem_run.append_increment(file, fem_run.StoredState(np.zeros(ndof), np.zeros(nlayer), 0.0, 0.1 * i, further),
                                      {"increment": i, "kick": False, "yield_element": False, "t": 0.1 * i})
     with open_file(path) as file:
         state = fem_run.RunFile(file).state(2)
-        assert len(state) == 5 and state[4]["well"].dtype == np.int64
-        np.testing.assert_array_equal(state[4]["depth"], np.full(ni, 1.0))
-        np.testing.assert_array_equal(state[4]["well"], np.arange(ni) + 2)
+        assert state.further["well"].dtype == np.int64
+        np.testing.assert_array_equal(state.further["depth"], np.full(ni, 1.0))
+        np.testing.assert_array_equal(state.further["well"], np.arange(ni) + 2)
         assert file["state/depth"].chunks == (1, ni)
-    # a file without further state gives the four items it always gave
+    # a file without further state: none read, none written
     _write(tmp_path / "plain.h5")
     with open_file(tmp_path / "plain.h5") as file:
-        assert len(fem_run.RunFile(file).state(1)) == 4 and sorted(file["state"]) == ["lever_target", "t", "target",
-                                                                                        "u"]
+        assert fem_run.RunFile(file).state(1).further == {}
+        assert sorted(file["state"]) == ["lever_target", "t", "target", "u"]
 
 
 def test_rows_beyond_nstored_are_dropped_by_rewrite(tmp_path):

@@ -17,8 +17,8 @@ from stickslip.mesh import MeshParams, build_stack_mesh
 def _backend(mesh, name, threads=1):
     """A CPU backend ``name`` prepared for the stack of ``mesh``."""
     params = FemParams(N=mesh.N, plates=mesh.plates, nchunk=20)
-    model, _ = stack_model(params, mesh, derived_constants(params, mesh))
-    return make_backend(name, threads).prepare(model, mesh)
+    model, wells = stack_model(params, mesh, derived_constants(params, mesh))
+    return make_backend(name, threads).prepare(model, mesh, wells.epsy)
 
 
 @pytest.mark.parametrize("plates_", [2, 3, 4, 5, 6])

@@ -24,7 +24,7 @@ def _constraints():
 def test_the_users_requirements_hold_no_cuda_compiler_and_ci_adds_them():
     users, ci = pins(ENVIRONMENT), pins(CI)
     assert not [name for name in users if GPU_TOOLS.match(name)]
-    assert {"numba-cuda", "nvidia-nvvm", "nvidia-cuda-nvrtc"} <= set(ci) and users.items() <= ci.items()
+    assert {"numba-cuda", "nvidia-nvvm", "nvidia-cuda-nvrtc", "nvidia-nvjitlink"} <= set(ci) and users.items() <= ci.items()
     assert "-r .ci/requirements.txt" in (ROOT / ".ci" / "run").read_text()
     assert "STICKSLIP_REQUIRE_CUDA_TOOLS=1" in (ROOT / ".ci" / "run").read_text()
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]

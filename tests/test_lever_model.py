@@ -143,7 +143,7 @@ def test_aging_law_is_the_threshold_without_disorder():
 
 @pytest.mark.parametrize("a", [1, 3])
 def test_individual_protocol(a):
-    params = quiet(protocol="individual", a=a, n=1)
+    params = quiet(protocol="individual", driven_slab=a, n=1)
     record, truth, _ = simulate(params)
     assert record.V == pytest.approx(V / a) and record.protocol == "individual" and record.a == a
     assert set(truth["a"]) == {a}
@@ -196,7 +196,7 @@ def test_creep_accounts_for_the_rest_of_the_sliding():
 
 def test_creep_vanishes_for_a_single_driven_slab():
     assert np.all(friction_law(quiet(n=1, creep_velocity=(0.002,))).creep_velocity == 0.0)
-    assert np.all(friction_law(quiet(protocol="individual", a=2, creep_velocity=(0.002,))).creep_velocity == 0.0)
+    assert np.all(friction_law(quiet(protocol="individual", driven_slab=2, creep_velocity=(0.002,))).creep_velocity == 0.0)
 
 
 def test_sampled_positions_follow_the_history():

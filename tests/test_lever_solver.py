@@ -54,9 +54,9 @@ def test_sensor_noise_does_not_change_the_slips():
 
 @pytest.mark.parametrize("values, message", [
     ({"n": 6}, "parameter 'n': expected a value <= n_slabs=5"),
-    ({"a": 2}, "parameter 'a': must be 0 for the stack protocol"),
-    ({"protocol": "individual"}, "parameter 'a': expected 1..n_slabs=5 for the individual protocol"),
-    ({"protocol": "individual", "a": 2, "n": 3}, "parameter 'n': must be 1 for the individual protocol"),
+    ({"driven_slab": 2}, "parameter 'driven_slab': must be 0 for the stack protocol"),
+    ({"protocol": "individual"}, "parameter 'driven_slab': expected 1..n_slabs=5 for the individual protocol"),
+    ({"protocol": "individual", "driven_slab": 2, "n": 3}, "parameter 'n': must be 1 for the individual protocol"),
     ({"B": "0.05,0.04"}, "parameter 'B': expected 1 or n_slabs=5 values, got 2"),
     ({"B": "0.001", "n": 5, "strength_offset": 0}, "parameter 'B': the weakest healing during a slip"),
     ({"protocol": "sideways"}, "parameter 'protocol'"),

@@ -24,7 +24,8 @@ from stickslip.fem.parameters import FemParams
 from stickslip.fem.random import pcg32_seed
 from stickslip.fem.thermal import redraws as redraws_module
 from stickslip.fem.thermal import sampler
-from stickslip.fem.thermal.junctions import expected_redraws, renew, widen
+from stickslip.fem.thermal.junctions import renew, widen
+from stickslip.fem.trap_model import expected_redraws
 from stickslip.fem.thermal.redraws import PAUSED, redraw_loop, sample_with_redraws
 from stickslip.fem.thermal.sampler import HOP, NONE, STALLED, THRESHOLD, draw_event, sample_event
 from stickslip.formats.fem_run import read_run_attrs

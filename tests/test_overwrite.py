@@ -82,7 +82,7 @@ def test_each_solver_refuses_another_run_passes_its_own_and_overwrites_when_aske
 
     assert main(RATE_STATE + ["--overwrite", "-o", str(target)]) == 0
     assert "--overwrite: moved it to" in capsys.readouterr().err
-    assert sha256(target) != made and sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"]
+    assert sha256(target) != made and sorted(p.name for p in tmp_path.iterdir()) == ["run.h5", "run.provenance.json"]
 
 
 def test_import_csv_and_mesh(tmp_path, capsys):

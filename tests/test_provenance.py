@@ -3,10 +3,13 @@
 import hashlib
 import json
 import shutil
+from pathlib import Path
 
 import pytest
 
+from stickslip import registry
 from stickslip.h5io import FileFormatError
+from stickslip.plugin_params import parse_params
 from stickslip.provenance import code
 from stickslip.hashing import sha256_file
 from stickslip.provenance.record import (REQUIRED_FIELDS, read_record, record_path, recording,
@@ -20,6 +23,12 @@ def test_code_hash_follows_package_imports():
             "cli/__init__.py"} <= sources
     assert "figures/style.py" not in sources
     assert len(code.code_hash("stickslip.h5io")) == 16
+
+
+def test_a_module_of_another_package_is_followed_into_this_one(toy_plugins):
+    sources = code.module_sources("stickslip_toy")  # a third-party plugin: one file importing the package
+    assert {"stickslip_toy", "stickslip.registry", "stickslip.formats.analysis_file"} <= set(sources.values())
+    assert len(code.code_hash("stickslip_toy")) == 16
 
 
 def test_the_public_api_is_in_no_plugins_code_hash(tmp_path, monkeypatch):
@@ -55,6 +64,76 @@ def test_code_hash_changes_with_the_sources(tmp_path, monkeypatch):
         assert code.code_hash("stickslip.figures.style") == unrelated
     finally:
         code.module_sources.cache_clear()
+
+
+@pytest.fixture
+def package(tmp_path, monkeypatch):
+    """A copy of the package, whose sources the code hashes read (``code.ROOT``)."""
+    package = tmp_path / "stickslip"
+    shutil.copytree(code.ROOT, package, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(code, "ROOT", package)
+    code.module_sources.cache_clear()
+    yield package
+    code.module_sources.cache_clear()
+
+
+def _job_hashes():
+    """The code hash of a job of each kind: fem runs by law and backend, other plugins, the database."""
+    fem = registry.get("solver", "fem")
+    hashes = {f"fem {law} {backend}": code.plugin_code_hash(fem, parse_params(fem.params, {
+        "interface_law": law, "backend": backend})) for law in ("cusp", "smooth") for backend in ("structured", "cuda")}
+    for kind, name in (("solver", "lever"), ("analysis", "numerical-events"), ("analysis", "experiment-events"),
+                       ("figure", "fig3"), ("figure", "figS-sequences")):
+        plugin = registry.get(kind, name)
+        hashes[name] = code.plugin_code_hash(plugin, plugin.params())
+    hashes["database"] = code.code_hash("stickslip.provenance.ingest")
+    return hashes
+
+
+def _append(path):
+    """A change inside a module: a comment at its end."""
+    path.write_text(path.read_text() + "# a change\n")
+
+
+def _edit(path, old, new):
+    text = path.read_text()
+    assert text.count(old) == 1, (path, old)
+    path.write_text(text.replace(old, new))
+
+
+def test_a_new_law_backend_plugin_or_vocabulary_entry_changes_no_jobs_code_hash(package):
+    before = _job_hashes()
+    assert len(set(before.values())) == len(before)
+    (package / "fem" / "laws" / "softening.py").write_text(
+        '"""A law no run chooses."""\n\nfrom .generic import register_law\nfrom .cusp import Cusp\n')
+    (package / "fem" / "backends" / "counting.py").write_text(
+        '"""A backend no run chooses."""\n\nfrom .cpu.structured import StructuredBackend\n')
+    for folder in ("solvers", "events", "figures"):  # a new solver, analysis and figure (the toy plugin's module)
+        shutil.copy(Path(__file__).parent / "toy_plugin" / "stickslip_toy.py", package / folder / "toy.py")
+    _edit(package / "vocabulary.py", '    "kind": _q(',
+          '    "new_quantity": _q("float64", "1", "a quantity no code names"),\n    "kind": _q(')
+    assert _job_hashes() == before
+
+
+def test_a_change_in_a_law_or_backend_changes_the_hash_of_the_runs_that_choose_it_only(package):
+    before = _job_hashes()
+    _append(package / "fem" / "laws" / "cusp.py")
+    after = _job_hashes()
+    assert {name for name in before if after[name] != before[name]} == {"fem cusp structured", "fem cusp cuda"}
+    _append(package / "fem" / "backends" / "cuda" / "kernels.py")
+    again = _job_hashes()
+    assert {name for name in before if again[name] != after[name]} == {"fem cusp cuda", "fem smooth cuda"}
+
+
+def test_a_vocabulary_entry_counts_in_the_jobs_whose_code_names_it(package):
+    before = _job_hashes()
+    # "R_slow": a column of the experimental analysis, which fig3 reads; no other job here names it
+    _edit(package / "vocabulary.py", '"fraction of the sliding made by slow slip',
+          '"share of the sliding made by slow slip')
+    assert {name for name, value in _job_hashes().items() if value != before[name]} == {"experiment-events", "fig3"}
+    _edit(package / "vocabulary.py", '"interface (slab) a, 1 = lowest"', '"interface (slab) a, from 1 at the bottom"')
+    assert {"numerical-events", "experiment-events", "database"} <= {
+        name for name, value in _job_hashes().items() if value != before[name]}
 
 
 def test_record_fields_hashes_and_atomic_write(tmp_path):

@@ -1,5 +1,10 @@
 """Bounds of one read-only query that hold for the process and are local to the query (issue 45, items 3, 4, 11-14).
 
+The audit of 575c37a (issue 59, items 2, 3): results that were wide passed both bounds (1e6 rows of 31 columns
+exited 0 after 99 s at 2.3 GB: a DataFrame was built and formatted outside them), and repeated column names were an
+AttributeError traceback. ``db sql --format csv|json`` now streams its rows, the time limit covers the writing,
+``sql()`` counts the table it returns.
+
 The audit of c47ca12: ``db sql``'s memory bound covered SQLite's heap only (2 000 blobs of 1 MB came back, 2.1 GB),
 it was process-wide and never lifted (a later default query and an unrelated sqlite3 connection failed), bad bound
 values were tracebacks or accepted, a blob in JSON was a UnicodeDecodeError, ``study().sql()`` took no bounds,
@@ -9,6 +14,8 @@ values were tracebacks or accepted, a blob in JSON was a UnicodeDecodeError, ``s
 import io
 import json
 import sqlite3
+import subprocess
+import sys
 from contextlib import redirect_stdout
 
 import pytest
@@ -133,3 +140,61 @@ def test_study_option_is_a_name_under_results(tmp_path, monkeypatch, capsys):
         error = _error_line(capsys)
         assert status == 2 and "--study" in error and "results/" in error, error
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Snakefile"]
+
+
+def _wide(rows, columns=31):
+    """The audit's wide result (issue 59, item 2): ``rows`` rows of ``columns`` integer columns."""
+    named = ", ".join(f"x AS c{i}" for i in range(columns))
+    return f"WITH RECURSIVE c(x) AS (SELECT 1 UNION ALL SELECT x + 1 FROM c LIMIT {rows}) SELECT {named} FROM c"
+
+
+STREAM = """
+import os, resource, sys
+from stickslip.cli import main
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+sys.stdout = open(os.devnull, "w")
+status = main(["db", "sql", sys.argv[1], "--db", sys.argv[2], "--format", sys.argv[3], "--time-limit", "0"])
+print(status, (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024, file=sys.stderr)
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fmt", ["csv", "json"])
+def test_csv_and_json_stream_a_wide_result_in_the_memory_of_a_piece(database, fmt):
+    # 100 000 rows of 31 columns: held whole, their rows and table take ~230 MiB (the audit: 1e6 rows, 2.3 GB)
+    done = subprocess.run([sys.executable, "-c", STREAM, _wide(100_000), str(database), fmt], capture_output=True,
+                          text=True, check=True)
+    status, grown = done.stderr.split()[-2:]
+    assert status == "0" and float(grown) < 120, done.stderr
+
+
+def test_the_time_limit_covers_the_writing_and_the_output_keeps_the_rows_before_it(database, capsys):
+    status, out = _db("sql", _wide(1_000_000), "--db", str(database), "--format", "csv", "--time-limit", "0.5")
+    error = _error_line(capsys)
+    assert status == 2 and "time limit of 0.5 s" in error, error
+    written = int(error.split("(the output holds the ")[1].split(" rows")[0])
+    assert 0 < written < 1_000_000 and len(out.splitlines()) == written + 1
+
+
+def test_sql_counts_the_table_it_returns_against_the_memory_bound(database):
+    # 100 000 rows of 31 numbers: ~92 MiB of fetched rows, ~47 MiB more for the DataFrame made of them
+    with pytest.raises(QueryError, match="memory limit of 120 MiB"):
+        sql(_wide(100_000), database, memory_limit_mib=120)
+    assert sql(_wide(1_000), database, memory_limit_mib=120).shape == (1_000, 31)
+
+
+@pytest.mark.parametrize("fmt", ["csv", "json", "table"])
+def test_repeated_column_names_are_made_unique(database, fmt):
+    # the audit (issue 59, item 3): an AttributeError traceback in every format
+    status, out = _db("sql", "SELECT 1 AS x, 2 AS x, x'ff' AS x", "--db", str(database), "--format", fmt)
+    assert status == 0
+    if fmt == "json":
+        assert json.loads(out) == [{"x": 1, "x.1": 2, "x.2": "ff"}]
+    elif fmt == "csv":
+        assert out.splitlines() == ["x,x.1,x.2", "1,2,ff"]
+    else:
+        assert out.splitlines()[0].split() == ["x", "x.1", "x.2"]
+    assert list(sql("SELECT 1 AS x, 2 AS x", database).columns) == ["x", "x.1"]
+    status, _ = _db("sql", "SELECT * FROM runs a JOIN runs b USING(run_id) LIMIT 1", "--db", str(database),
+                    "--format", fmt)
+    assert status == 0

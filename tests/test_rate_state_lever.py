@@ -226,7 +226,7 @@ def test_the_default_tolerance_resolves_the_slips_to_the_sensor_resolution():
     (force noise: 0.002 in mu; camera noise: 0.002 mm) over 1500 s (measured over 6000 s: they agree
     to 4093 s, then the onsets drift apart by more than 0.02 s; at rtol 1e-4 from 396 s)."""
     plugin = registry.get("solver", "rate-state-lever")
-    values = {"protocol": "individual", "n": 1, "a": 1, "duration": 1500.0}
+    values = {"protocol": "individual", "n": 1, "driven_slab": 1, "duration": 1500.0}
     default, reference = (rate_state_model.simulate(parse_params(plugin.params, dict(values, rtol=rtol)))[1]
                           for rtol in (plugin.params().rtol, 1e-9))
     assert len(default) == len(reference) >= 5
@@ -242,7 +242,7 @@ def _simulate(tmp_path, name, **values):
 
 
 def test_same_parameters_same_bytes_and_seeds_differ(tmp_path):
-    paths = [_simulate(tmp_path, name, protocol="individual", n=1, a=2, duration=500.0, seed=seed)
+    paths = [_simulate(tmp_path, name, protocol="individual", n=1, driven_slab=2, duration=500.0, seed=seed)
              for name, seed in (("a", 1), ("b", 1), ("c", 2))]
     digests = [hashlib.sha256(p.read_bytes()).hexdigest() for p in paths]
     assert digests[0] == digests[1] != digests[2]
@@ -355,7 +355,7 @@ def test_a_shuffled_stack_carries_each_slabs_interface_with_the_slab(tmp_path):
         truth = rate_state_model.simulate(parse_params(plugin.params, dict(common, **values)))[1]
         return truth[(truth["t_start"] > 300.0) & (truth["a"] == truth["a"].min())]
 
-    alone, carried, first = slips(protocol="individual", a=4), slips(n=1, slab_order=order), slips(n=1)
+    alone, carried, first = slips(protocol="individual", driven_slab=4), slips(n=1, slab_order=order), slips(n=1)
     assert carried["T"].mean() == pytest.approx(alone["T"].mean(), rel=0.01)
     assert carried["dmu"].mean() == pytest.approx(alone["dmu"].mean(), abs=0.002)
     assert abs(first["T"].mean() / alone["T"].mean() - 1) > 0.1

@@ -44,7 +44,7 @@ def _run(tmp_path, name, **values):
 def test_without_path_disorder_the_correlation_length_changes_nothing(tmp_path):
     """path_disorder = 0 (the default) leaves mu0 exactly constant: any correlation length writes the
     same signals and ground truth, bit for bit (individual protocol a = 2, 500 s, seed 1)."""
-    values = dict(protocol="individual", n=1, a=2, duration=500.0, seed=1)
+    values = dict(protocol="individual", n=1, driven_slab=2, duration=500.0, seed=1)
     assert (_dataset_digest(_run(tmp_path, "default", **values))
             == _dataset_digest(_run(tmp_path, "zero", path_disorder=0.0, path_correlation_length=0.1, **values)))
 
@@ -154,7 +154,7 @@ def test_steady_sliding_over_a_heterogeneous_path_averages_to_mu_ss_with_the_imp
 
 
 def _individual(epsilon, seed=1, duration=3000.0):
-    values = dict(protocol="individual", n=1, a=1, duration=duration, seed=seed, path_disorder=epsilon)
+    values = dict(protocol="individual", n=1, driven_slab=1, duration=duration, seed=seed, path_disorder=epsilon)
     _, truth, _, _ = rate_state_model.simulate(parse_params(PLUGIN.params, values))
     return truth[truth["t_start"] > 300.0]
 
@@ -175,7 +175,7 @@ def test_with_path_disorder_runs_stay_deterministic_and_the_lever_balances(tmp_p
     """path_disorder = 0.02: the same seed gives the same bytes, another seed (another path) other ones;
     and in the stack n = 3 the moment of the springs on the lever equals that of the friction (taken
     at each interface's place on its path) plus the slabs' inertia at every step, to 1e-6 of F H."""
-    paths = [_run(tmp_path, name, protocol="individual", n=1, a=2, duration=500.0, seed=seed, path_disorder=0.02)
+    paths = [_run(tmp_path, name, protocol="individual", n=1, driven_slab=2, duration=500.0, seed=seed, path_disorder=0.02)
              for name, seed in (("a", 1), ("b", 1), ("c", 2))]
     digests = [hashlib.sha256(p.read_bytes()).hexdigest() for p in paths]
     assert digests[0] == digests[1] != digests[2]

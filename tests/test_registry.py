@@ -49,6 +49,23 @@ def test_register_get_and_run_id():
         registry.get("solver", "nope")
 
 
+def test_a_plugin_without_parameters_needs_no_class_and_a_choice_names_a_parameter():
+    registry.register("analysis", "test-no-parameters", "1", consumes=("fem-run",), produces="event-table")(_analysis)
+    plugin = registry.get("analysis", "test-no-parameters")
+    assert plugin.params is registry.NoParameters and parse_params(plugin.params, {}) == registry.NoParameters()
+    with pytest.raises(Exception, match="'x'"):
+        parse_params(plugin.params, {"x": 1})  # no parameter at all
+    parts = {"a": Params, "b": dict}
+    choice = registry.Choice("x", {"one": Params})
+    assert choice.modules() == {__name__} and choice.module(Params(x="one")) == __name__
+    with pytest.raises(registry.PluginError, match="choices name parameters it does not have: y"):
+        registry.register("solver", "test-bad-choice", "1", Params, produces="fem-run",
+                          choices=(registry.Choice("y", parts),))(lambda params, output, *, threads, inputs: None)
+    with pytest.raises(registry.PluginError, match="choices must be Choice objects of a solver"):
+        registry.register("analysis", "test-choice", "1", Params, consumes=("fem-run",), produces="event-table",
+                          choices=(registry.Choice("x", parts),))(_analysis)
+
+
 def _analysis(params, input, output):
     """Test analysis."""
 

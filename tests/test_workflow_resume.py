@@ -94,7 +94,7 @@ def test_a_kept_run_of_other_code_is_made_again(tmp_path, monkeypatch):
     output.unlink()
     record.unlink()
     COMPUTED.clear()
-    monkeypatch.setattr("stickslip.workflow_api.code_hash", lambda module: "0123456789abcdef")  # code changed
+    monkeypatch.setattr("stickslip.workflow_api.plugin_code_hash", lambda plugin, params: "0123456789abcdef")  # code changed
     run_simulation(*args, inputs={}, threads=1)
     assert COMPUTED == [0, 1, 2]
     assert "completed by other code" in log.read_text()

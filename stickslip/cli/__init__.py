@@ -2,9 +2,10 @@
 
 Each module in :data:`COMMANDS` defines ``add_parser(subparsers)``, which adds its
 sub-command and sets ``func(args) -> int`` as the parser default. Errors of the
-user's making (bad parameter, unknown plugin, unreadable file) are printed as one
-line ``stickslip: error: ...`` with exit status 2, never as a traceback. Every command that writes a
-file refuses an existing output that holds another run unless given ``--overwrite``. Ctrl-C and
+user's making (bad parameter, unknown plugin, unreadable file, a run the solver cannot make with the
+parameters given) are printed as one line ``stickslip: error: ...`` with exit status 2, never as a
+traceback. Every command that writes a file refuses an existing output that holds another run unless
+given ``--overwrite``. Ctrl-C and
 SIGTERM end a command cleanly (files closed, what a run stored is kept) with exit
 status 130 (SIGINT) or 143 (SIGTERM). Warnings of the package (parameters outside the studied regime)
 are one line ``stickslip: warning: ...``.
@@ -17,6 +18,7 @@ import textwrap
 import warnings
 
 from .. import __version__
+from ..errors import SolverError
 from ..h5io import FileFormatError
 from ..output_safety.errors import OutputError
 from ..plugin_params import ParameterError, ParameterWarning
@@ -26,9 +28,11 @@ from ..termination import exit_status, interrupts_raised, interruption
 __all__ = ["main", "COMMANDS", "add_overwrite_option"]
 
 #: Sub-command modules, in the order of ``stickslip --help``.
-COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db")
+COMMANDS = ("mesh", "simulate", "increments", "analyze_experiment", "import_csv", "plugins", "db", "browse")
 
-USER_ERRORS = (ParameterError, PluginError, FileFormatError, OutputError)
+#: Errors of the user's making, printed as one line (exit 2): a bad parameter, plugin, file or output, and a run
+#: that the parameters ask for but the solver cannot make (:class:`stickslip.errors.SolverError`).
+USER_ERRORS = (ParameterError, PluginError, FileFormatError, OutputError, SolverError)
 
 #: What ``stickslip --help`` says first: what the tool is for, in the user's terms.
 DESCRIPTION = textwrap.fill("Stick-slip in a stack of elastic slabs: run the paper's simulations (finite elements, a virtual "
@@ -44,6 +48,7 @@ EPILOG = ("examples:\n"
           "  stickslip import-csv --force F.csv --positions X.csv --n 3 -o lab.h5\n"
           "  stickslip analyze-experiment lab.h5 -o slips.csv --aging\n"
           "  stickslip db events --regime stiff               slip events of the study's database\n"
+          "  stickslip browse --study ci                      the study in the browser, read only\n"
           "`stickslip COMMAND --help` describes each command; README.md and docs/ the study.")
 
 
@@ -85,7 +90,7 @@ def main(argv=None):
         with interrupts_raised():
             return args.func(args) or 0
     except USER_ERRORS as error:
-        print(f"stickslip: error: {error}", file=sys.stderr)
+        print(f"stickslip: error: {' '.join(str(error).split())}", file=sys.stderr)
         return 2
     except BaseException as error:
         interrupt = interruption(error)

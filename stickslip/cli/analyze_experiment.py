@@ -13,7 +13,8 @@ import pandas as pd
 
 from ..experiment.aging import FITS, fit_single_slips
 from ..experiment.analysis import ExperimentEventsParams, analyse_record
-from ..experiment.plausibility import force_rate_warning, missing_drop_error, no_slip_warning, travel_warning
+from ..experiment.plausibility import (force_range_warning, force_rate_warning, missing_drop_error, no_slip_warning,
+                                      travel_warning)
 from ..experiment.timeseries import read_timeseries
 from ..output_safety.overwrite import write_text_output
 from ..plugin_params import ParameterError, parse_assignments, parse_params
@@ -62,8 +63,8 @@ def run(args):
         missing = missing_drop_error(record, slips, str(path))
         if missing:
             raise ParameterError(missing)
-        found = (force_rate_warning(record, str(path)), travel_warning(record, str(path)),
-                 no_slip_warning(record, len(slips), str(path)))
+        found = (force_range_warning(record, str(path)), force_rate_warning(record, str(path)),
+                 travel_warning(record, str(path)), no_slip_warning(record, len(slips), str(path)))
         warnings += [line for line in found if line]
     for line in warnings:
         print(f"stickslip: warning: {line}", file=sys.stderr)

@@ -12,6 +12,9 @@ are those of ``stickslip.study(...).runs/events`` (:mod:`stickslip.provenance.fi
 """
 
 import argparse
+import csv
+import json
+import math
 import os
 import sys
 from pathlib import Path
@@ -26,6 +29,7 @@ from ..provenance.ingest import find_records, ingest
 from ..provenance.migrate import migrate
 from ..provenance.query import MAX_ROWS, MEMORY_LIMIT_MIB, TIME_LIMIT_S
 from ..study_plan import check_study_name
+from ..vocabulary import quantity
 from ..workdir import ENVIRONMENT, find_workdir
 
 FORMATS = ("table", "csv", "json")
@@ -35,9 +39,8 @@ DESCRIPTION = ("Query and (re)build the results database of a study: results/STU
                "workflow directory (the nearest folder with a Snakefile at or above the current one, or "
                f"--workdir, or ${ENVIRONMENT}).")
 
-#: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column).
-RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "protocol", "n", "driven_slab", "blocks", "phi",
-               "regime", "temperature", "seed", "wall_time_s", "peak_memory_mib", "git_commit", "git_dirty")
+#: Columns shown by ``db runs`` in table format (``--all-columns`` shows every column): the API's narrow ``runs()``.
+RUN_COLUMNS = query.RUN_COLUMNS
 
 EVENT_COLUMNS = ("simulation_run_id", "analysis", "source", "solver", "n", "regime", "seed", "event",
                  "interface", "slip", "dmu", "dmu_sig0", "multi", "time", "t", "increment")
@@ -52,14 +55,19 @@ def _study(name):
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
-def _database_options(parser):
-    parser.add_argument("--study", default="default", type=_study,
+def _database_options(parser, defaults=True):
+    """``--study``, ``--workdir``, ``--db``: on ``db`` (with their defaults) and on each of its sub-commands, where
+    they default to what was given before the sub-command (``db --workdir DIR runs`` and ``db runs --workdir DIR``)."""
+    def default(value):
+        return value if defaults else argparse.SUPPRESS
+
+    parser.add_argument("--study", default=default("default"), type=_study,
                         help="study whose database to use: results/STUDY/stickslip.sqlite in the workflow directory "
                              "(default: default)")
-    parser.add_argument("--workdir", type=Path, default=None, metavar="DIR",
+    parser.add_argument("--workdir", type=Path, default=default(None), metavar="DIR",
                         help=f"the workflow directory (default: ${ENVIRONMENT}, else the nearest folder at or above "
                              "the current one with a Snakefile)")
-    parser.add_argument("--db", type=Path, default=None, help="database file (overrides --study)")
+    parser.add_argument("--db", type=Path, default=default(None), help="database file (overrides --study)")
 
 
 def _results(args):
@@ -116,7 +124,7 @@ def _filters(args, specs):
 
 
 def _common(parser, default_format="table"):
-    _database_options(parser)
+    _database_options(parser, defaults=False)
     parser.add_argument("--format", choices=FORMATS, default=default_format, help="output format (default table)")
     parser.add_argument("--all-columns", action="store_true", help="every column (table format shows the main ones)")
 
@@ -124,6 +132,7 @@ def _common(parser, default_format="table"):
 def add_parser(subparsers):
     """Add the ``db`` sub-command and its own sub-commands."""
     parser = subparsers.add_parser("db", help="query or rebuild the results database", description=DESCRIPTION)
+    _database_options(parser)
     commands = parser.add_subparsers(dest="db_command", required=True, metavar="DB_COMMAND")
 
     def command(name, summary):
@@ -155,17 +164,17 @@ def add_parser(subparsers):
 
     ingest = command("ingest", "add provenance records to the database (idempotent)")
     ingest.add_argument("records", nargs="+", type=Path, help="*.provenance.json files")
-    _database_options(ingest)
+    _database_options(ingest, defaults=False)
     ingest.set_defaults(func=run_ingest)
 
     rebuild = command("rebuild", "recreate the database from every record under the results")
-    _database_options(rebuild)
+    _database_options(rebuild, defaults=False)
     rebuild.add_argument("--results", type=Path, default=None,
                          help="results tree whose records to read (default results/STUDY)")
     rebuild.set_defaults(func=run_rebuild)
 
     migrate = command("migrate", "bring a database of an older schema to this one, keeping its rows")
-    _database_options(migrate)
+    _database_options(migrate, defaults=False)
     migrate.set_defaults(func=run_migrate)
 
 
@@ -183,12 +192,13 @@ PIECE = 10_000
 
 def _text_of_blobs(frame):
     """``frame`` with every bytes value (an SQL blob) as its hexadecimal text (JSON and CSV have no bytes)."""
-    blobs = [c for c in frame.columns if frame[c].dtype == object and frame[c].map(type).eq(bytes).any()]
+    blobs = [k for k in range(frame.shape[1]) if frame.dtypes.iloc[k] == object
+             and frame.iloc[:, k].map(type).eq(bytes).any()]
     if not blobs:
         return frame
     frame = frame.copy()
-    for column in blobs:
-        frame[column] = frame[column].map(lambda v: v.hex() if isinstance(v, bytes) else v)
+    for k in blobs:
+        frame.isetitem(k, frame.iloc[:, k].map(lambda v: v.hex() if isinstance(v, bytes) else v))
     return frame
 
 
@@ -236,9 +246,76 @@ def run_events(args):
 
 
 def run_sql(args):
-    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2."""
-    return _query(args, "sql", None, args.query, time_limit=args.time_limit, max_rows=args.max_rows,
-                  memory_limit_mib=args.memory_limit)
+    """``db sql``: errors of SQL (syntax, an attempt to write) are user errors: one line, exit 2.
+
+    The table format shows the result as one bounded table (:func:`stickslip.provenance.query.sql`); CSV and
+    JSON are streamed (:func:`stickslip.provenance.query.sql_pieces`): every row is written as it is fetched,
+    never a table of the whole result, and the time limit covers the writing.
+    """
+    bounds = {"time_limit": args.time_limit, "max_rows": args.max_rows, "memory_limit_mib": args.memory_limit}
+    if args.format == "table":
+        return _query(args, "sql", None, args.query, **bounds)
+    written = 0
+    try:
+        with query.sql_pieces(args.query, _database(args), **bounds) as pieces:
+            for rows in streamed_text(pieces, args.format):
+                written += rows
+    except query.QueryError as error:
+        kept = f" (the output holds the {written} rows before it)" if written else ""
+        print(f"stickslip: error: {error}{kept}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # `stickslip db sql ... | head`: the reader stopped, not an error
+        sys.stdout = open(os.devnull, "w")
+    return 0
+
+
+def streamed_text(pieces, fmt):
+    """Write the rows of a query to stdout as CSV or JSON, piece by piece; yield the rows of each piece written.
+
+    Values as SQLite gives them, a blob as its hexadecimal text; the columns of the vocabulary that are booleans
+    (``multi``, ``git_dirty``, ...) as true and false (CSV: ``True``, ``False``, as pandas writes them); NULL as
+    an empty field (CSV) or ``null`` (JSON, also for a non-finite number).
+    """
+    convert = [_value_converter(name) for name in pieces.columns]
+    if fmt == "csv":
+        writer = csv.writer(sys.stdout, lineterminator="\n")
+        writer.writerow(pieces.columns)
+    else:
+        sys.stdout.write("[")
+    written = 0
+    for piece in pieces:
+        rows = [[c(v) for c, v in zip(convert, row)] for row in piece]
+        if fmt == "csv":
+            writer.writerows([["" if v is None else v for v in row] for row in rows])
+        elif rows:
+            sys.stdout.write(",\n" if written else "\n")
+            sys.stdout.write(",\n".join(json.dumps(dict(zip(pieces.columns, map(_finite, row))), allow_nan=False)
+                                        for row in rows))
+        written += len(rows)
+        yield len(rows)
+    if fmt == "json":
+        sys.stdout.write("\n]\n" if written else "]\n")
+
+
+def _finite(value):
+    """A value for JSON, which has no infinity: a non-finite number as None."""
+    return None if isinstance(value, float) and not math.isfinite(value) else value
+
+
+def _value_converter(name):
+    """How a value of column ``name`` is written: a blob as hexadecimal text, a boolean of the vocabulary as a
+    bool (where it is 0 or 1)."""
+    found = quantity(name)
+    boolean = found is not None and found.dtype == "bool"
+
+    def convert(value):
+        if isinstance(value, bytes):
+            return value.hex()
+        if boolean and value in (0, 1) and not isinstance(value, str):
+            return bool(value)
+        return value
+
+    return convert
 
 
 def run_ingest(args):

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from ..experiment.csv_import import UNITS, import_csv
-from ..experiment.plausibility import force_rate_warning, travel_warning
+from ..experiment.plausibility import force_range_warning, force_rate_warning, travel_warning
 from ..experiment.timeseries import PROTOCOLS
 from . import add_overwrite_option
 
@@ -56,7 +56,8 @@ def run(args):
                         time_unit=args.time_unit, force_unit=args.force_unit,
                         position_unit=args.position_unit, overwrite=args.overwrite)
     print(f"{args.output}: {record.t_F.size} force samples, {record.t_x.size} frames of {record.n_slabs} slabs")
-    for warning in (force_rate_warning(record, str(args.force)), travel_warning(record, str(args.positions))):
+    for warning in (force_range_warning(record, str(args.force)), force_rate_warning(record, str(args.force)),
+                    travel_warning(record, str(args.positions))):
         if warning:
             print(f"stickslip: warning: {warning}", file=sys.stderr)
     return 0

@@ -22,9 +22,15 @@ def add_parser(subparsers):
     parser.set_defaults(func=run)
 
 
+#: Rows formatted and written at a time: the text of a table is never held whole.
+PIECE = 10_000
+
+
 def run(args):
-    """Read the observables and write the CSV."""
+    """Read the observables and write the CSV, :data:`PIECE` rows at a time."""
     table = read_increments(args.run)
-    write_text_output(args.output, table.to_csv(index=False, float_format="%.17g"), overwrite=args.overwrite)
+    pieces = (table.iloc[start:start + PIECE].to_csv(index=False, header=start == 0, float_format="%.17g")
+              for start in range(0, max(len(table), 1), PIECE))
+    write_text_output(args.output, pieces, overwrite=args.overwrite)
     print(f"{args.output}: {len(table)} increments, {len(table.columns)} columns")
     return 0

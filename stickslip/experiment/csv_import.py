@@ -41,6 +41,10 @@ UNITS = {
     "length": {"mm": 1.0, "um": 1e-3, "µm": 1e-3, "m": 1e3},
 }
 
+#: The unit of each quantity in the format.
+_FORMAT_UNITS = {quantity: next(unit for unit, factor in units.items() if factor == 1.0) for quantity, units in
+                 UNITS.items()}
+
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
 
 
@@ -54,13 +58,31 @@ def _refuse_semicolons(path):
                               f"separator and '.' as decimal point)")
 
 
+#: Names a message lists at most (a header of 100 000 columns is one short line, not one of 800 kB).
+_LISTED = 8
+
+
+def _listed(names):
+    """Names comma-separated, at most :data:`_LISTED` of them and how many more, each cut to 40 characters."""
+    shown = [_cut(name, 40) for name in names[:_LISTED]]
+    more = f" and {len(names) - _LISTED} more" if len(names) > _LISTED else ""
+    return ", ".join(shown) + more
+
+
+def _cut(text, length):
+    """``text`` cut to ``length`` characters (with ``...``)."""
+    text = str(text)
+    return text if len(text) <= length else text[:length - 3] + "..."
+
+
 def _parse_header(path, header):
     """Map each column name to its unit ('' when the header has none)."""
     columns = {}
     for position, text in enumerate(header, start=1):
         match = _HEADER.match(str(text))
         if match is None:
-            raise FileFormatError(f"{path}: header column {position} {text!r} is not of the form 'name [unit]'")
+            raise FileFormatError(f"{path}: header column {position} {_cut(text, 80)!r} is not of the form "
+                                  "'name [unit]'")
         name, unit = match.group(1), match.group(2) or ""
         if name in columns:
             raise FileFormatError(f"{path}: column '{name}' appears twice in the header")
@@ -121,12 +143,12 @@ def read_csv_columns(path, quantities, units):
     table = table.iloc[1:].reset_index(drop=True)
     missing = [name for name in quantities if name not in header]
     if missing:
-        raise FileFormatError(f"{path}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}; "
-                              f"expected exactly {', '.join(quantities)}")
+        raise FileFormatError(f"{path}: missing column{'s' if len(missing) > 1 else ''} {_listed(missing)}; "
+                              f"expected exactly {_listed(list(quantities))}")
     unexpected = [name for name in header if name not in quantities]
     if unexpected:
         raise FileFormatError(f"{path}: unexpected column{'s' if len(unexpected) > 1 else ''} "
-                              f"{', '.join(unexpected)}; expected exactly {', '.join(quantities)}")
+                              f"{_listed(unexpected)}; expected exactly {_listed(list(quantities))}")
     if len(table) < 2:
         raise FileFormatError(f"{path}: expected at least 2 data rows, got {len(table)}")
     lines = _data_line_numbers(path, len(table))
@@ -139,14 +161,22 @@ def read_csv_columns(path, quantities, units):
         if np.any(bad):
             row = int(np.argmax(bad))
             raise FileFormatError(f"{path}: line {lines[row]}, column '{name}': expected a finite number, "
-                                  f"got {text[name].iloc[row]!r}")
-        values[name] = column * factor
+                                  f"got {_cut(text[name].iloc[row], 40)!r}")
+        with np.errstate(over="ignore"):
+            values[name] = column * factor
+        beyond = ~np.isfinite(values[name])
+        if np.any(beyond):
+            row = int(np.argmax(beyond))
+            raise FileFormatError(f"{path}: line {lines[row]}, column '{name}': {_cut(text[name].iloc[row], 40)} "
+                                  f"times {factor:g} (to {_FORMAT_UNITS[quantities[name]]}) is beyond the range of a "
+                                  "double")
     time_name = next(iter(quantities))
     steps = np.diff(values[time_name])
     if np.any(steps <= 0):
         row = int(np.argmax(steps <= 0)) + 1
         raise FileFormatError(f"{path}: line {lines[row]}, column '{time_name}': time must increase strictly, "
-                              f"got {text[time_name].iloc[row]!r} after {text[time_name].iloc[row - 1]!r}")
+                              f"got {_cut(text[time_name].iloc[row], 40)!r} after "
+                              f"{_cut(text[time_name].iloc[row - 1], 40)!r}")
     return {name: values[name] for name in quantities}
 
 

@@ -20,6 +20,10 @@ times too small. Two facts of the lever apparatus (docs/experiment-model.md) exp
   virtual runs of both protocols, n = 1 ... 5: 0.9-1.3 times the rate). A rate off by more than
   :data:`FORCE_FACTOR` is implausible (:func:`force_rate_warning`): a force file in ms labelled s, with
   a correct positions file, passes the travel check.
+- **The springs hold at most the friction of every interface.** A driven spring cannot pull harder than the
+  friction of all ``n_slabs`` interfaces at the normal force (no friction coefficient exceeds 1), and acts on
+  the lever with its arm ``j h / H``: a force record beyond :data:`FORCE_FACTOR` times the sum of these is
+  implausible (:func:`force_range_warning`; a force of 1e308 N is a broken export, not a measurement).
 - **Every slip has its drop.** The force drop of a slip is read from the force record around the
   slip's time, found in the positions: slips whose drop could not be measured (the two records
   do not cover the same times) make the analysis fail (:func:`missing_drop_error`).
@@ -29,8 +33,8 @@ Each warning names the unit mistakes whose factor is within half a decade of wha
 
 import numpy as np
 
-__all__ = ["travel_warning", "no_slip_warning", "force_rate_warning", "measured_loading_rate", "missing_drop_error", "FACTOR", "STICKS",
-           "FORCE_FACTOR"]
+__all__ = ["travel_warning", "no_slip_warning", "force_rate_warning", "force_range_warning", "measured_loading_rate",
+           "missing_drop_error", "FACTOR", "STICKS", "FORCE_FACTOR"]
 
 #: Travel off by more than this factor (either way) is implausible.
 FACTOR = 3.0
@@ -50,6 +54,9 @@ _TRAVEL_MISTAKES = (("positions in m (not mm)", 1e-3), ("positions in cm (not mm
 _FORCE_MISTAKES = (("times in ms (not s)", 1e-3), ("times in min (not s)", 60.0), ("times in h (not s)", 3600.0),
                    ("force in kN (not N)", 1e-3), ("force in mN (not N)", 1e3), ("V in m/s (not mm/s)", 1e3),
                    ("V in um/s (not mm/s)", 1e-3))
+
+#: Unit mistakes of a force file, by the factor they multiply its largest force with.
+_FORCE_RANGE_MISTAKES = (("force in mN (not N)", 1e3),)
 
 #: Unit mistakes of one file's times, by the factor they multiply the force record's span over the positions' with.
 _SPAN_MISTAKES = (("times in ms (not s) in the force file", 1e3), ("times in ms (not s) in the positions file", 1e-3),
@@ -108,6 +115,24 @@ def _loading_rate(record):
     return sum(record.k_spring * speed * slab / fastest * slab * record.h / record.H for slab in slabs)
 
 
+def _largest_force(record):
+    """The largest lever force the springs can hold [N] (module docstring)."""
+    slabs = range(1, record.n + 1) if record.protocol == "stack" else [record.a]
+    return sum(record.n_slabs * record.normal_force * slab * record.h / record.H for slab in slabs)
+
+
+def force_range_warning(record, source):
+    """A one-line warning if the force record exceeds what the springs can hold, else None (``record``, and the force
+    file ``source`` named in the message, as :func:`force_rate_warning`'s)."""
+    largest = _largest_force(record)
+    found = float(np.max(np.abs(record.F)))
+    if found <= FORCE_FACTOR * largest:
+        return None
+    return (f"{source}: the lever force reaches {found:.3g} N, {found / largest:.2g} times the {largest:.3g} N its "
+            f"springs can hold (each at most the friction of the {record.n_slabs} interfaces at N = "
+            f"{record.normal_force:g} N, on its arm j h / H); {_likely(found / largest, _FORCE_RANGE_MISTAKES)}")
+
+
 def measured_loading_rate(t, F):
     """Upper decile of the force's slopes over :data:`_WINDOWS` windows of the record [N / time unit].
 
@@ -121,7 +146,8 @@ def measured_loading_rate(t, F):
     float
     """
     edges = np.unique(np.clip(np.searchsorted(t, np.linspace(t[0], t[-1], _WINDOWS + 1)), 0, t.size - 1))
-    return float(np.percentile(np.diff(F[edges]) / np.diff(t[edges]), 90)) if edges.size > 2 else float("nan")
+    with np.errstate(over="ignore", invalid="ignore"):  # forces near the largest double: not a finite rate
+        return float(np.percentile(np.diff(F[edges]) / np.diff(t[edges]), 90)) if edges.size > 2 else float("nan")
 
 
 def force_rate_warning(record, source):

@@ -1,7 +1,5 @@
 """The errors of the fem solver."""
 
+from ..errors import SolverError
+
 __all__ = ["SolverError"]
-
-
-class SolverError(RuntimeError):
-    """The protocol cannot continue (no convergence, no yielding step found, a hop that broke its promise)."""

@@ -12,6 +12,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from .backends.base import unbounded_wells
 from .event_driven import autoscale
 from .laws import Elastic
 from .yield_strains import element_scale, interface_initstate, narrowest_well
@@ -44,9 +45,8 @@ def compute_linear_response(stack, model, relaxation, params, mesh):
     -------
     LinearResponse
     """
-    elastic = model._replace(law=Elastic(params.K, params.G),
-                             epsy=np.tile(np.array([[-np.inf, np.inf]]), (model.epsy.shape[0], 1)))
-    backend = stack.backend_for(elastic)
+    backend = stack.backend_for(model._replace(law=Elastic(params.K, params.G)),
+                                unbounded_wells(model.iface_dofs.shape[0]))
     unit_target = 2.0 * params.eps0 * np.asarray(mesh.layer_mid_height, dtype=np.float64)
     backend.set_state(np.zeros(model.ndof), unit_target, params.eps0, 0.0)
     relaxation.equilibrate_linear(backend)

@@ -106,10 +106,10 @@ class Loading:
             If no yielding step exists or the step broke its promise (an index changed
             during a load step, or none during a kick).
         """
-        token = self.stack.watch()
+        token = self.stack.checkpoint()
         step = self.step_size(kick, yield_element)
         self.load(step)
-        changed = self.stack.moved(token)
+        changed = self.stack.changed_since(token) > 0
         if kick and not changed:
             # the step is found with the CPU's arithmetic, to just past a yield strain; a backend of other round-off
             # (a GPU's fused multiply-adds) can leave the point a rounding error short of it: kick again from where
@@ -118,7 +118,7 @@ class Loading:
             extra = self.step_size(kick, yield_element, bisect=False)
             self.load(extra)
             step += extra
-            changed = self.stack.moved(token)
+            changed = self.stack.changed_since(token) > 0
         if kick != changed:
             raise SolverError(f"{'kick' if kick else 'load step'} of size {step:.6e}: well indices "
                               f"{'did not change' if kick else 'changed'}")

@@ -1,10 +1,10 @@
 """The discretised model as arrays: ``Model``, physics and discretisation, fixed for a run.
 
 A named tuple of numpy arrays and scalars, so that numba kernels take it whole: operators,
-masses, the interfaces' geometry, law and yield strains, the drive. How its products are
+masses, the interfaces' geometry and law, the drive. How its products are
 computed (threads, plate kernels, scratch) and the state it acts on are a backend's
-(:mod:`.backends`); only the backend replaces its yield strains, when the window of held yield
-strains moves (:meth:`.backends.base.Backend.set_yield_strains`).
+(:mod:`.backends`). The yield strains are not the model's: they are state, which the backend holds (its copy the
+only one), given to it by the window of held yield strains (:meth:`.backends.base.Backend.set_yield_strains`).
 Units are the FE model's own: length (block size ``h = pi``), stress (``G = 1``),
 mass density (``rho = 1``), time (``dt = 0.05``; shear-wave speed ``c_s = sqrt(G / 2 / rho)``).
 """
@@ -31,7 +31,6 @@ Model = namedtuple("Model", [
     "iface_dNdx",     # float64 [ni, 4, 4, 2] [1/length]
     "iface_dV",       # float64 [ni, 4] [length^2]
     "law",            # the interface law (:mod:`.laws`), e.g. Cusp(K, G)
-    "epsy",           # float64 [ni, ny]: yield strains per interface element [strain]
     "layer_ptr",      # int64 [nlayer + 1]: slices of layer_xdofs / layer_w
     "layer_xdofs",    # int64 [sum m_l]
     "layer_w",        # float64 [sum m_l]: ubar_x = sum w u [1]
@@ -42,7 +41,7 @@ Model = namedtuple("Model", [
     "lever_ratio",    # float64 [nlayer]: h_l / H (free lever), layer height over drive height
 ])
 
-def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height):
+def build_model(mesh, *, law, rho, alpha, dt, k_drive, drive_active, free_lever, lever_height):
     """Assemble the model arrays of a layered mesh.
 
     Parameters
@@ -50,8 +49,6 @@ def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_
     mesh : stickslip.mesh.LayeredMesh
         Needs ``coor``, ``conn``, ``dofs``, ``iip``, ``elem_layer``, ``nlayer``,
         ``layer_is_plastic``, ``layer_mid_height``, ``interface_elements``.
-    epsy : numpy.ndarray
-        [n_interfaces * N, ny] yield strains, rows in ``interface_elements`` order.
     law : tuple
         The interface law (:mod:`.laws`); the plates are elastic with its moduli ``law.K``,
         ``law.G`` [stress].
@@ -81,8 +78,6 @@ def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_
     elem_layer = np.asarray(mesh.elem_layer, dtype=np.int64)
     elastic = np.flatnonzero(~plastic_layer[elem_layer])
     iface = np.asarray(mesh.interface_elements, dtype=np.int64).ravel()
-    if epsy.shape[0] != iface.size:
-        raise ValueError(f"epsy has {epsy.shape[0]} rows; expected one per interface element ({iface.size})")
 
     k_ptr, k_col, k_val = assemble_csr(edofs[elastic], elastic_element_stiffness(dNdx[elastic], dV[elastic], law.K,
                                                                                  law.G), ndof)
@@ -106,7 +101,7 @@ def build_model(mesh, *, epsy, law, rho, alpha, dt, k_drive, drive_active, free_
     return Model(
         ndof=ndof, dt=float(dt), k_ptr=k_ptr, k_col=k_col, k_val=k_val, mass_inv=mass_inv, damping=damping,
         prescribed=prescribed, multiplicity=multiplicity, iface_dofs=edofs[iface], iface_dNdx=dNdx[iface],
-        iface_dV=dV[iface], law=law, epsy=np.ascontiguousarray(epsy, dtype=np.float64),
+        iface_dV=dV[iface], law=law,
         layer_ptr=np.asarray(ptr, dtype=np.int64), layer_xdofs=np.concatenate(xdofs),
         layer_w=np.concatenate(weights), layer_volume=np.asarray(volume),
         drive_active=np.asarray(drive_active, dtype=bool), k_drive=float(k_drive), free_lever=bool(free_lever),

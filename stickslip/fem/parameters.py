@@ -10,10 +10,11 @@ import math
 import warnings
 
 from ..formats import fem_run
+from ..h5io import FileFormatError
 from ..plugin_params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
-from .thermal.junctions import expected_redraws
+from .trap_model import expected_redraws
 
 __all__ = ["FemParams", "DRIVES", "RELAXATIONS", "SEQUENCE_ENDS", "CYCLE_STRAIN", "REACH_MIN", "REACH_REGIME",
            "REACH_MELT", "CLOCK_ATTEMPTS", "REDRAWS_MAX", "thermal_reach", "stored_params"]
@@ -45,7 +46,7 @@ REACH_MELT = 1.0
 #: tells one attempt time from the next (2^52, its resolution): such an attempt rate is refused.
 CLOCK_ATTEMPTS = 2.0 ** 52
 #: Redraws of one junction in a stick-slip cycle (or hold) that the trap model expects
-#: (:func:`.thermal.junctions.expected_redraws`) beyond which a run would not end (hours per cycle): refused.
+#: (:func:`.trap_model.expected_redraws`) beyond which a run would not end (hours per cycle): refused.
 REDRAWS_MAX = 1e6
 
 
@@ -77,36 +78,42 @@ def thermal_reach(temperature, attempt_rate, drive_rate):
 class FemParams:
     """Parameters of one simulation of the stack (see the field docs for units)."""
 
-    N: int = param(1458, "blocks per interface (mesh: 2*3^k, or small values such as 9)", minimum=3)
+    N: int = param(1458, "blocks per interface (mesh: 2*3^k, or small values such as 9; a run that needs more memory "
+                         "than the machine has is refused with its estimate)", minimum=3, maximum=10**6)
     plates: int = param(2, "number of elastic plates (n = plates - 1 interfaces)", minimum=2, maximum=6)
     seed: int = param(0, "realisation id; the disorder of element e of the interfaces uses pcg32 seed "
-                         "seed*N*99 + e", minimum=0)
+                         "seed*N*99 + e (within int64)", minimum=0, maximum=2**31 - 1)
     k_drive: float = param(1e-3, "drive spring stiffness per unit volume (1e-3 stiff, 1e-6 compliant)",
-                           unit="G/h^2", exclusive_minimum=0.0)
+                           unit="G/h^2", minimum=1e-12, maximum=1e2)
     drive: str = param("fixed-lever", "drive configuration", choices=DRIVES)
     nchunk: int = param(6000, "random yield strains per block of the paper's code: the linear response is scaled "
                               "to the narrowest of these wells; with yield_strains = 'stop' they are all a block "
-                              "has", minimum=10)
+                              "has", minimum=10, maximum=10**6)
     yield_strains: str = param("extend", "'extend': a block's yield-strain sequence is unbounded (held `window` "
                                          "wells at a time, drawn further from its own generator as it advances); "
                                          "'stop': `nchunk` wells, the run stops `margin` wells before their end "
                                          "(the paper's code)", choices=SEQUENCE_ENDS)
     window: int = param(1000, "yield_strains 'extend': wells per block held in memory (widened when one event "
-                              "needs more); the results do not depend on it", minimum=20)
-    G: float = param(1.0, "shear modulus G = 2 mu (plates and interfaces)", unit="stress", exclusive_minimum=0.0)
+                              "needs more); the results do not depend on it", minimum=20, maximum=10**6)
+    G: float = param(1.0, "shear modulus G = 2 mu (plates and interfaces)", unit="stress", minimum=1e-6, maximum=1e6)
     K: float = param(4.5, "bulk-like modulus K (energy K eps_m^2, eps_m = tr(eps)/2)", unit="stress",
-                     exclusive_minimum=0.0)
-    rho: float = param(1.0, "mass density", unit="mass/length^2", exclusive_minimum=0.0)
+                     minimum=1e-6, maximum=1e6)
+    rho: float = param(1.0, "mass density", unit="mass/length^2", minimum=1e-6, maximum=1e6)
     eps0: float = param(5e-5, "typical yield strain (well widths 2 eps0 Weibull + eps_offset)",
-                        exclusive_minimum=0.0)
-    eps_offset: float = param(1e-6, "minimal well width", minimum=0.0)
-    weibull_k: float = param(2.0, "Weibull shape parameter of the well widths", exclusive_minimum=0.0)
-    deps: float = param(1e-4, "kick size in equivalent strain", unit="eps0", exclusive_minimum=0.0)
+                        minimum=1e-9, maximum=0.1)
+    eps_offset: float = param(1e-6, "minimal well width (yield_strains 'extend': wider than the kick "
+                                        "deps * eps0)", minimum=0.0, maximum=0.1)
+    weibull_k: float = param(2.0, "Weibull shape parameter of the well widths", minimum=0.1, maximum=100.0)
+    deps: float = param(1e-4, "kick size in equivalent strain", unit="eps0", minimum=1e-10, maximum=0.1)
     dt_scale: float = param(1.0, "time step in units of the paper's dt = h / (2 pi c) / 10 (1 = the paper's "
-                                 "protocol; 2-4 keep the event statistics, not each event: docs/fem.md)", exclusive_minimum=0.0, maximum=8.0)
-    tol: float = param(1e-5, "minimisation: relative residual tolerance", exclusive_minimum=0.0, maximum=0.5)
-    niter_tol: int = param(20, "minimisation: consecutive steps below tol (and non-increasing)", minimum=1)
-    max_iter: int = param(10_000_000, "minimisation: maximum time steps (then the run fails)", minimum=1)
+                                 "protocol; 2-4 keep the event statistics, not each event: docs/fem.md)", minimum=1e-3,
+                          maximum=8.0)
+    tol: float = param(1e-5, "minimisation: relative residual tolerance (below round-off, ~1e-15, never met: the "
+                                 "run ends after max_iter steps)", exclusive_minimum=0.0, maximum=0.5)
+    niter_tol: int = param(20, "minimisation: consecutive steps below tol (and non-increasing); at most max_iter",
+                          minimum=1, maximum=10**7)
+    max_iter: int = param(10_000_000, "minimisation: maximum time steps (then the run fails)", minimum=1,
+                         maximum=10**12)
     relaxation: str = param("dynamic", "how minimisations end: 'dynamic' (damped dynamics until the residual "
                                        "criterion, the paper's protocol) or 'exact' (equilibrium of the current wells "
                                        "solved directly once no well changed for quiet_steps, accepted only if every "
@@ -115,17 +122,17 @@ class FemParams:
     quiet_steps: int = param(0, "relaxation 'exact': time steps without any well change before an equilibrium "
                                 "solve is tried (and between tries); 0: the time a shear wave takes to cross a "
                                 "third of the interface, L / (3 c_s), about 30 N steps at dt_scale 1 (shorter "
-                                "windows end events early: docs/fem.md)", minimum=0)
+                                "windows end events early: docs/fem.md)", minimum=0, maximum=10**9)
     margin: int = param(5, "a block within this many wells of the end of its held sequence stops the run "
                            "('stop') or makes the event be redone with more wells held ('extend'; with "
                            "max_increments 0 a block within this many wells of the end of its first nchunk wells "
-                           "stops the run)", minimum=1)
+                           "stops the run)", minimum=1, maximum=10**5)
     lever_height: float = param(10.0, "free lever: height of the drive spring on the lever",
-                                unit="H_1 - H_0 (mid-height distance of layers 1 and 0)", exclusive_minimum=0.0)
+                                unit="H_1 - H_0 (mid-height distance of layers 1 and 0)", minimum=1e-3, maximum=1e3)
     max_increments: int = param(0, "stop after this many increments; 0: stop where the paper's code does, when a "
                                    "block comes within `margin` wells of the end of its first `nchunk` wells (with "
                                    "'stop' the increment is aborted there; with 'extend' it is completed, not "
-                                   "stored)", minimum=0)
+                                   "stored)", minimum=0, maximum=10**12)
     interface_law: str = param("cusp", "potential of the interface blocks in a well (docs/fem.md, 'Interface laws')",
                                choices=INTERFACE_LAWS, extension=True)
     law_params: tuple[float, ...] = param((), "the interface law's parameters after K and G, in the order the law "
@@ -149,17 +156,17 @@ class FemParams:
                                           extension="temperature")
     hold_delay: float = param(0.0, "temperature > 0 with hold_times: the drive's advance after a slip event at "
                                    "which the hold starts (a slip before it postpones the hold)", unit="eps0",
-                              minimum=0.0, extension="temperature")
+                              minimum=0.0, maximum=1e6, extension="temperature")
     junction_strengthening: float = param(0.0, "junction aging (docs/fem.md, 'Junction aging'): the half-width of a "
                                                "block's current well grows by this times the depth E of its contact "
                                                "junction, its centre fixed; 0: no aging (needs temperature > 0 and "
                                                "a law whose stress depends on the well's centre only, the cusp)",
-                                          unit="eps0 / (G eps0^2 h^2)", minimum=0.0, extension=True)
+                                          unit="eps0 / (G eps0^2 h^2)", minimum=0.0, maximum=1e3, extension=True)
     junction_glass_temperature: float = param(8e-3, "junction aging: scale T_g of the depths drawn, rho(E) = "
                                                     "exp(-E / T_g) / T_g, when a block enters a well and at every "
                                                     "redraw; the typical depth grows as temperature x ln t below T_g",
                                               unit="G eps0^2 h^2", exclusive_minimum=0.0,
-                                              extension="junction_strengthening")
+                                              maximum=1e3, extension="junction_strengthening")
     junction_attempt_rate: float = param(1.0, "junction aging: a junction of depth E is redrawn at rest at the rate "
                                               "nu_j exp(-E / temperature)", unit="1/time", exclusive_minimum=0.0,
                                          extension="junction_strengthening")
@@ -191,6 +198,13 @@ class FemParams:
                     raise ParameterError(f"parameter '{name}': used only with temperature > 0; expected a "
                                          "temperature > 0 or the default")
         self._check_junctions()
+        if self.niter_tol > self.max_iter:
+            raise ParameterError(f"parameter 'niter_tol': {self.niter_tol} consecutive steps cannot fit in max_iter = "
+                                 f"{self.max_iter} steps; expected niter_tol <= max_iter")
+        if self.yield_strains == "extend" and self.eps_offset <= self.deps * self.eps0:
+            raise ParameterError(f"parameter 'eps_offset': {self.eps_offset:g} lets a well be no wider than the kick "
+                                 f"deps * eps0 = {self.deps * self.eps0:g} (with yield_strains 'extend' any well may "
+                                 "be as narrow as eps_offset); expected eps_offset > deps * eps0")
         if self.nchunk <= 2 * self.margin:
             raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
                                  f"(margin = {self.margin}); expected nchunk > 2 * margin")
@@ -213,9 +227,10 @@ class FemParams:
             raise ParameterError("parameter 'junction_strengthening': junction aging needs thermal activation; "
                                  "expected temperature > 0 or junction_strengthening = 0")
         if not getattr(INTERFACE_LAWS[self.interface_law], "junction_aging", False):
+            aging = [name for name, law in INTERFACE_LAWS.items() if getattr(law, "junction_aging", False)]
             raise ParameterError(f"parameter 'junction_strengthening': law '{self.interface_law}' has a stress that "
                                  "depends on the well's width, so a junction cannot widen it at rest; expected "
-                                 "interface_law 'cusp' or junction_strengthening = 0")
+                                 f"interface_law {' or '.join(map(repr, aging))} or junction_strengthening = 0")
         _refuse_beyond_clock(self, "junction_attempt_rate", self.junction_attempt_rate)
         _refuse_endless_redraws(self)
 
@@ -229,8 +244,9 @@ class FemParams:
             raise ParameterError(f"parameter 'relaxation': law '{law.name}' has a curvature that the elastic stiffness "
                                  "does not bound, so 'exact' cannot converge; expected 'dynamic'")
         if self.temperature > 0.0 and not law.thermal:
-            raise ParameterError(f"parameter 'temperature': law '{law.name}' has no exact barriers for thermal "
-                                 "activation; expected 0")
+            raise ParameterError(f"parameter 'temperature': law '{law.name}' is not thermal (the exact sampling of "
+                                 "the hops needs an exact backward barrier and barriers quasi-concave in eps_eq "
+                                 "within a well); expected 0")
 
 
 def _stretch(params):
@@ -313,8 +329,13 @@ def stored_params(file):
     Raises
     ------
     stickslip.h5io.FileFormatError
-        If the file is not a ``fem-run`` file of the current version.
-    stickslip.plugin_params.ParameterError
-        If its parameters are not those of a :class:`FemParams`.
+        If the file is not a ``fem-run`` file of the current version, or its parameters are not those of a
+        :class:`FemParams` (a damaged file: the message names it).
     """
-    return parse_params(FemParams, fem_run.read_params(file), owner=f"{file.filename}: params")
+    stored = fem_run.read_params(file)
+    try:
+        return parse_params(FemParams, stored, owner=f"{file.filename}: params")
+    except ParameterError as error:
+        raise FileFormatError(f"{file.filename}: attribute 'params' holds parameters no fem run has ({error}): the "
+                              "file is damaged or not what it claims; remake it (rerun the job that wrote "
+                              "it)") from None

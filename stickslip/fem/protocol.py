@@ -1,7 +1,8 @@
 """The protocol of a run: one event-driven loop whose named hooks decide which perturbation comes next.
 
 A protocol drives a stack (:class:`.stack.Stack`) one stored increment at a time for the increment
-loop of :mod:`.run`; increments alternate, a load then an event, as in the paper. :class:`EventLoop`
+loop of :mod:`.run`; increments alternate, a load then an event, as in the paper, and the protocol knows which
+comes next (:meth:`EventLoop.step`). :class:`EventLoop`
 is that loop, once for every protocol; a protocol overrides its hooks, not the loop (as FrictionQPotFEM's
 thermal class does):
 
@@ -22,14 +23,18 @@ Its other interface, for the increment loop:
     dict of the root attributes it adds to the run file;
 ``state_fields``
     dict name -> (shape, dtype) of further state it stores per increment beside the stack's
-    displacement, drive and time (the fifth item of :meth:`.stack.Stack.stored`, e.g. the junctions);
+    displacement, drive and time (:attr:`.formats.fem_run.StoredState.further`, e.g. the junctions);
 ``initial_row()``
     its columns for increment 0;
-``step(event, margin, increment)``
-    the loop: the next increment (number ``increment``), a load (``event`` False) or an event (True), its
-    columns with ``yield_element``;
+``step(margin, increment)``
+    the loop: the next increment (number ``increment``), a load or an event, whichever is next, its
+    columns with ``kick`` (True: the event) and ``yield_element``;
 ``stored(row)``
     is told the row just appended (e.g. to start a hold after a slip).
+
+Going back (a relaxation redone with more wells held, the whole-element fallback of a kick, a hop that fell back)
+returns to a checkpoint (:meth:`.stack.Stack.checkpoint`), kept where the state is: a device backend's state does
+not come to the host for it.
 
 :class:`AthermalProtocol` is the paper's: the athermal threshold is the only source of events and the event
 is the kick. :class:`.thermal.ThermalProtocol` (``temperature > 0``) draws its events from composed event
@@ -53,39 +58,48 @@ class EventLoop:
         Steps along the stack's linear response.
     relaxation : stickslip.fem.relaxation.DynamicRelaxation or stickslip.fem.relaxation.ExactRelaxation
         How a perturbed stack comes to rest.
+    table : Mapping[str, numpy.ndarray], optional
+        The stored increment table's columns (a resumed run: its last ``kick`` tells what comes next); None: the
+        stack is at rest after an event (increment 0, a stored event, a hold's start), a load comes next.
 
     Attributes
     ----------
     pending : object or None
         The event a load increment ended at, what :meth:`perform` is given next (None: none, or the athermal
         protocol's, whose event is always the kick).
+    event_next : bool
+        Whether the next increment is an event (else a load).
     """
 
     columns = {}
     header = {}
     state_fields = {}
 
-    def __init__(self, stack, loading, relaxation):
+    def __init__(self, stack, loading, relaxation, table=None):
         self.stack = stack
         self.loading = loading
         self.relaxation = relaxation
         self.pending = None
+        self.event_next = table is not None and not bool(np.asarray(table["kick"])[-1])
 
     @staticmethod
     def initial_row():
         """No columns of its own."""
         return {}
 
-    def step(self, event, margin, increment):
-        """The next increment: :meth:`next_event` (a load), or :meth:`perform` the pending event and
-        :meth:`after_event` (an event)."""
-        if not event:
-            return self.next_event(margin, increment)
-        pending, self.pending = self.pending, None
-        row = self.perform(pending, margin)
-        if row is not None:
-            self.after_event(margin, increment)
-        return row
+    def step(self, margin, increment):
+        """The next increment, number ``increment``: :meth:`next_event` (a load), or :meth:`perform` the pending event
+        and :meth:`after_event` (an event), whichever is next; its columns with ``kick`` (True: the event), None if
+        the run must stop at the margin."""
+        event, self.event_next = self.event_next, not self.event_next
+        if event:
+            pending, self.pending = self.pending, None
+            row = self.perform(pending, margin)
+            if row is not None:
+                self.after_event(margin, increment)
+        else:
+            row = self.next_event(margin, increment)
+        return None if row is None else {"kick": event, **row}
 
     def next_event(self, margin, increment):
         """Hook: bring the stack to the next event, set :attr:`pending`; the load increment's columns (None: stop)."""
@@ -101,12 +115,12 @@ class EventLoop:
     def stored(self, row):
         """Told the row just appended (nothing to remember here)."""
 
-    def perturb_and_relax(self, perturbation, margin, record=False):
+    def perturb_and_relax(self, perturbation, margin, record=False, before=None, ahead=True):
         """Perturb the stack and relax it; with ``extend``, redone until the held wells suffice.
 
-        The stack relaxes (:meth:`.stack.Stack.relax`: with ``extend`` the wells are then held ahead).
+        The stack relaxes (:meth:`.stack.Stack.relax`: with ``extend`` and ``ahead`` the wells are then held ahead).
         With ``yield_strains = extend``, a relaxation that comes within ``margin`` wells of the end
-        of the held wells is discarded: the state before the perturbation is restored, the windows
+        of the held wells is discarded: the stack rolls back to its checkpoint before the perturbation, the windows
         are widened (doubled) and the perturbation redone, which gives the state a longer sequence
         held from the start would give.
 
@@ -120,6 +134,10 @@ class EventLoop:
             See :meth:`.relaxation.DynamicRelaxation.relax`.
         record : bool, optional
             Record the well changes of Gauss point 0, the perturbation's own included (at its time).
+        before : stickslip.fem.stack.Checkpoint, optional
+            A checkpoint of the stack as it is (default: one is made).
+        ahead : bool, optional
+            False: the windows are not moved after the relaxation (:meth:`.stack.Stack.relax`).
 
         Returns
         -------
@@ -129,18 +147,18 @@ class EventLoop:
             [nevent, 3] (element, time, direction) when ``record``.
         """
         stack = self.stack
-        before = stack.stored()
+        before = stack.checkpoint() if before is None else before
+        start, t0 = (stack.well_index()[:, 0], stack.time) if record else (None, None)
         while True:
-            token = stack.watch()
             perturbation.apply()
-            kicked = stack.well_changes(token)[:, 0]
-            niter, events = stack.relax(self.relaxation, margin, record)
+            kicked = stack.well_index()[:, 0] - start if record else None
+            niter, events = stack.relax(self.relaxation, margin, record, ahead)
             if niter or not stack.extend:
                 break
-            stack.restore(*before)
+            stack.rollback(before)
             stack.widen_wells()
         if record:
-            rows = [(e, before[3], np.sign(kicked[e])) for e in np.flatnonzero(kicked) for _ in range(abs(kicked[e]))]
+            rows = [(e, t0, np.sign(kicked[e])) for e in np.flatnonzero(kicked) for _ in range(abs(kicked[e]))]
             events = np.concatenate([np.asarray(rows, dtype=np.float64).reshape(-1, 3), events])
         return niter, events
 
@@ -148,9 +166,8 @@ class EventLoop:
         """Kick and relax (an event increment), with the whole-element fallback.
 
         :meth:`perturb_and_relax` with the kick along the linear response; if the relaxation ends
-        with no well index changed (the kicked point fell back), the state before the kick is
-        restored and the kick redone so that all Gauss points of one element yield
-        (``yield_element``).
+        with no well index changed (the kicked point fell back), the stack rolls back to the state before the kick
+        and the kick is redone so that all Gauss points of one element yield (``yield_element``).
 
         Parameters
         ----------
@@ -165,13 +182,12 @@ class EventLoop:
             Whether the whole-element kick was needed.
         """
         stack = self.stack
-        before = stack.stored()
-        token = stack.watch()
-        niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, False), margin)
-        fallback = niter != 0 and not stack.moved(token)
+        before = stack.checkpoint()
+        niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, False), margin, before=before)
+        fallback = niter != 0 and not stack.changed_since(before)
         if fallback:
-            stack.restore(*before)
-            niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, True), margin)
+            stack.rollback(before)
+            niter, _ = self.perturb_and_relax(KickAlongResponse(self.loading, True), margin, before=before)
         return niter != 0, fallback
 
 

@@ -111,7 +111,7 @@ class EventReplay:
             If the increment is not stored.
         """
         stack = self.simulation.stack
-        stack.restore(*self._state(increment))
+        stack.restore(self._state(increment))
         eps, sig = stack.read("eps", "sig")
         return {"eps": eps.reshape(-1, self.N, 4, 3).copy(), "sig": sig.reshape(-1, self.N, 4, 3).copy(),
                 "well": stack.well_index().reshape(-1, self.N, 4)}
@@ -148,12 +148,12 @@ class EventReplay:
             raise FileFormatError(f"{self.path}: increment {increment} is not a stored kick increment")
         before, after = self._state(increment - 1), self._state(increment)
         s = self.simulation
-        s.stack.restore(*before)
+        s.stack.restore(before)
         kick = KickAlongResponse(s.loading, bool(self._yield_element[increment]))
         niter, events = s.protocol.perturb_and_relax(kick, self.params.margin, record=True)
         u, = s.stack.read("u")
-        if niter == 0 or not np.array_equal(u, after[0]) or s.stack.time != after[3]:
+        if niter == 0 or not np.array_equal(u, after.u) or s.stack.time != after.t:
             raise AssertionError(f"{self.path}: replaying increment {increment} did not reproduce the stored state")
         element = events[:, 0].astype(np.int64)
-        return pd.DataFrame({"a": element // self.N + 1, "block": element % self.N, "t": events[:, 1] - before[3],
+        return pd.DataFrame({"a": element // self.N + 1, "block": element % self.N, "t": events[:, 1] - before.t,
                              "direction": events[:, 2].astype(np.int64)})

@@ -45,8 +45,8 @@ __all__ = ["simulate_to_file"]
 FREE_SPACE_MARGIN = 4 * 2**20
 
 
-def _row(observer, increment, event, previous_index, columns):
-    row = {"increment": increment, "kick": event, **columns}
+def _row(observer, increment, previous_index, columns):
+    row = {"increment": increment, **columns}
     row.update(observer.observe(previous_index))
     return row
 
@@ -99,8 +99,8 @@ def _create(path, params, mesh, backend, producer):
                         columns + list(protocol.columns), protocol.columns, protocol.state_fields,
                         arithmetic=backend_arithmetic(backend.name))
             append_increment(file, simulation.stack.stored(),
-                             _row(observer, 0, True, observer.well_index(),
-                                  {"yield_element": False, **protocol.initial_row()}))
+                             _row(observer, 0, observer.well_index(),
+                                  {"kick": True, "yield_element": False, **protocol.initial_row()}))
 
 
 def _stored(output, params):
@@ -191,9 +191,8 @@ def _increments(params, output, backend):
                                 table=read_table(file, "increments", rows=run.nstored))
         stack, protocol = simulation.stack, simulation.protocol
         increment = run.nstored - 1
-        stack.restore(*run.state(increment))
+        stack.restore(run.state(increment))
         observer = Observer(simulation)
-        event = bool(file["increments/kick"][increment])
         previous_index = observer.well_index()
         new = 0
         reason = ""
@@ -205,8 +204,7 @@ def _increments(params, output, backend):
                 reason = "max_increments"
                 break
             increment += 1
-            event = not event
-            columns = protocol.step(event, params.margin, increment)
+            columns = protocol.step(params.margin, increment)
             if columns is None:
                 reason = "margin"
                 break
@@ -214,7 +212,7 @@ def _increments(params, output, backend):
                 reason = "margin"
                 break
             check_free_space(output, needed, FREE_SPACE_MARGIN)
-            row = _row(observer, increment, event, previous_index, columns)
+            row = _row(observer, increment, previous_index, columns)
             append_increment(file, stack.stored(), row)
             protocol.stored(row)
             previous_index = observer.well_index()

@@ -29,7 +29,7 @@ def make_protocol(simulation, table=None):
     s = simulation
     if s.params.temperature > 0.0:
         return thermal_protocol(s.stack, s.model, s.loading, s.relaxation, s.params, s.mesh, s.constants, table)
-    return AthermalProtocol(s.stack, s.loading, s.relaxation)
+    return AthermalProtocol(s.stack, s.loading, s.relaxation, table)
 
 
 class Simulation:
@@ -69,7 +69,7 @@ class Simulation:
         self.mesh = mesh
         self.constants = derived_constants(params, mesh)
         self.model, wells = stack_model(params, mesh, self.constants)
-        self.backend = backend.prepare(self.model, mesh)
+        self.backend = backend.prepare(self.model, mesh, wells.epsy)
         self.stack = Stack(self.backend, wells, params.yield_strains == "extend")
         self.relaxation = make_relaxation(params, self.constants, self.model)
         if response is None:

@@ -6,21 +6,51 @@ blocks' unbounded sequences (:class:`.window.HeldWindow`): a well's global index
 the window's offset, and with ``yield_strains = extend`` the windows are moved ahead of the Gauss points
 after every relaxation that moved something (:meth:`Stack.relax`). What the backend holds may be modified
 by one **yield-strain modifier** that a protocol registers (:meth:`Stack.modify_yield_strains`; junction
-aging): a stored state then includes the modifier's state as a fifth item. The stack's time is its backend's
-(the time steps of the dynamics) unless a protocol keeps its own clock (:meth:`Stack.keep_time`, a thermal
-run's: :mod:`.clock`). The stack imports nothing of the protocols.
+aging): a stored state then includes the modifier's state (:attr:`.formats.fem_run.StoredState.further`). The
+stack's time is its backend's (the time steps of the dynamics) unless a protocol keeps its own clock
+(:meth:`Stack.keep_time`, a thermal run's: :mod:`.clock`). The stack imports nothing of the protocols.
+
+Two ways back to a state: a **checkpoint** (:meth:`Stack.checkpoint`, :meth:`Stack.rollback`) is kept where the
+state is, on a device backend's device, and nothing of it comes to the host; whether a Gauss point changed well
+since one is a number counted there (:meth:`Stack.changed_since`). A **stored state** (:meth:`Stack.stored`,
+:meth:`Stack.restore`) is the run file's record, host copies. The stack reads the state through host copies made
+once per state (:class:`.host_copies.HostCopies`): a state returned to by a rollback is not copied again.
 """
+
+from typing import NamedTuple
 
 import numpy as np
 
-from .backends.base import read_only
+from ..formats.fem_run import StoredState
 from .errors import SolverError
+from .host_copies import HostCopies
 from .laws import make_law
 from .model import build_model
 from .window import HeldWindow
 from .yield_strains import HeldYieldStrains, element_scale, interface_initstate
 
-__all__ = ["Stack", "stack_model"]
+__all__ = ["Stack", "Checkpoint", "stack_model"]
+
+
+class Checkpoint(NamedTuple):
+    """A checkpoint of a stack (:meth:`Stack.checkpoint`): the backend's own, and what the stack keeps beside it.
+
+    Attributes
+    ----------
+    backend
+        The backend's checkpoint (:meth:`.backends.base.Backend.checkpoint`), kept where the state is.
+    window : tuple
+        The windows of yield strains (:meth:`.window.HeldWindow.snapshot`).
+    modified : dict
+        The modifier's state (its ``stored()``); empty without a modifier.
+    copies : dict
+        The host copies of the state (:meth:`.host_copies.HostCopies.now`).
+    """
+
+    backend: object
+    window: tuple
+    modified: dict
+    copies: dict
 
 
 class Stack:
@@ -29,17 +59,17 @@ class Stack:
     Parameters
     ----------
     backend : stickslip.fem.backends.base.Backend
-        Prepared for the stack's model (it owns the state); private to the stack from then on.
+        Prepared for the stack's model (it owns the state; it is given the windows' yield strains at once); private.
     wells : HeldYieldStrains
         The held windows of the blocks' yield-strain sequences.
     extend : bool
-        ``yield_strains = extend``: the windows follow the Gauss points (else they hold the whole sequence); an
-        attribute of the same name.
+        ``yield_strains = extend`` (the windows follow the Gauss points); an attribute of the same name.
     """
 
     def __init__(self, backend, wells, extend):
         self._backend = backend
-        self._window = HeldWindow(backend, wells)
+        self._copies = HostCopies(backend)
+        self._window = HeldWindow(backend, wells, self._copies)
         self._clock = None
         self.extend = extend
 
@@ -71,62 +101,66 @@ class Stack:
     @property
     def time(self):
         """The stack's time [time]: the kept clock's, else the time of the backend's dynamics."""
-        return self._clock.time if self._clock is not None else float(self._backend.read("t")[0][0])
+        return self._clock.time if self._clock is not None else float(self.read("t")[0][0])
 
     def read(self, *fields):
-        """The state fields ``fields`` (:data:`.backends.base.FIELDS`), a tuple of read-only arrays."""
-        return self._backend.read(*fields)
+        """The state fields ``fields`` (:data:`.backends.base.FIELDS`), a tuple of read-only host copies."""
+        return self._copies.read(*fields)
 
     @property
     def yield_strains(self):
         """The yield strains the backend holds now: the windows, modified (if a modifier is registered), float64
         [ni, ny], read only (they change when the windows move)."""
-        return read_only(self._backend.model.epsy)
+        return self._window.held
 
     def well_index(self):
         """Global well index of every interface Gauss point (counted from the start of the sequence), int64 [ni, 4]."""
-        return self._backend.read("idx")[0] + self.wells.offset[:, None]
-
-    def watch(self):
-        """A token for :meth:`moved` and :meth:`well_changes`: the well of every Gauss point now."""
-        return self.well_index()
-
-    def moved(self, token):
-        """Whether a Gauss point changed well since :meth:`watch` gave ``token``."""
-        return not np.array_equal(self.well_index(), token)
-
-    def well_changes(self, token):
-        """Wells moved by every Gauss point since :meth:`watch` gave ``token``: int64 [ni, 4] (+ forward)."""
-        return self.well_index() - token
+        return self.read("idx")[0] + self.wells.offset[:, None]
 
     def within_margin(self, margin):
         """True if every Gauss point is more than ``margin`` wells from the end of the held yield strains."""
-        return bool(np.all(self._backend.read("idx")[0] < self.wells.epsy.shape[1] - margin))
+        return bool(np.all(self.read("idx")[0] < self.wells.epsy.shape[1] - margin))
+
+    def checkpoint(self):
+        """A :class:`Checkpoint` of the whole state (the backend's part stays where the state is: no copy to the host)."""
+        modified = {} if self.modifier is None else self.modifier.stored()
+        return Checkpoint(self._backend.checkpoint(), self._window.snapshot(), modified, self._copies.now())
+
+    def rollback(self, token):
+        """Return to the state of :class:`Checkpoint` ``token``, bit for bit: the backend's state, the windows, the
+        modifier's state. A protocol's clock is left alone (time goes on: :mod:`.clock`)."""
+        self._backend.rollback(token.backend)
+        self._window.resume(token.window)
+        if token.modified:
+            self.modifier.restore(token.modified)
+        self._copies.resume(token.copies)
+
+    def changed_since(self, token, elements=None):
+        """How many Gauss points (of ``elements``, int64; default all) are in another global well than at
+        :class:`Checkpoint` ``token``, counted where the state is (:meth:`.backends.base.Backend.wells_changed`)."""
+        shift = self.wells.offset - token.window[0][1]
+        moved = not shift.any()
+        count = self._backend.wells_changed(token.backend, None if moved else shift, elements)
+        if count == 0 and moved and elements is None:
+            self._copies.same_wells(token.copies)
+        return count
 
     def stored(self):
-        """Copies of what :meth:`restore` needs, the state stored per increment: (u, target, lever_target, t),
-        and with a modifier its state (``stored()``) as a fifth item."""
-        u, target, lever = self._backend.read("u", "target", "lever")
-        state = (u.copy(), target.copy(), float(lever[0]), self.time)
-        return state if self.modifier is None else (*state, self.modifier.stored())
+        """The state stored per increment: a :class:`.formats.fem_run.StoredState` (``further``: the modifier's state)."""
+        u, target, lever = self.read("u", "target", "lever")
+        further = {} if self.modifier is None else self.modifier.stored()
+        return StoredState(u, target, float(lever[0]), self.time, further)
 
-    def restore(self, u, target, lever_target, t, modified=None):
-        """Set a stored state (at rest) and, with ``extend``, move the windows to it (:meth:`hold_wells_ahead`).
-
-        Parameters
-        ----------
-        u, target, lever_target, t
-            A stored state (:meth:`stored`): displacement [ndof], drive targets [nlayer] (recomputed for a free
-            lever), a free lever's drive target, time.
-        modified : dict, optional
-            The modifier's state (its ``stored()``), set before the displacement.
-        """
-        if modified is not None:
-            self.modifier.restore(modified)
+    def restore(self, state):
+        """Set a :class:`.formats.fem_run.StoredState` (at rest; its ``further`` first); with ``extend``, move the
+        windows to it (:meth:`hold_wells_ahead`)."""
+        if state.further:
+            self.modifier.restore(state.further)
             self._window.push()
-        self._backend.set_state(u, target, lever_target, t)
+        self._backend.set_state(state.u, state.target, state.lever_target, state.t)
+        self._copies.changed()
         if self._clock is not None:
-            self._clock.restore(t)
+            self._clock.restore(state.t)
         if self.extend:
             self.hold_wells_ahead()
 
@@ -137,26 +171,25 @@ class Stack:
     def load(self, step):
         """Move the displacement and the drive by ``step`` times the load direction (no dynamics)."""
         self._backend.load(step)
+        self._copies.changed()
 
     def add_u(self, dofs, delta):
         """Add ``delta`` [len(dofs)] to the displacement of ``dofs`` (int64), no dynamics."""
         self._backend.add_u(dofs, delta)
+        self._copies.changed()
 
-    def relax(self, relaxation, margin, record=False):
-        """Bring the stack to rest with ``relaxation``; with ``extend``, then hold the wells ahead.
-
-        Parameters and returns (``niter``, 0 if stopped by the margin; ``events``) as
-        :meth:`.relaxation.DynamicRelaxation.relax`; ``relaxation`` a ``DynamicRelaxation`` or ``ExactRelaxation``.
-        """
+    def relax(self, relaxation, margin, record=False, ahead=True):
+        """Relax (as :meth:`.relaxation.DynamicRelaxation.relax`); with ``extend``, then hold the wells ahead, unless
+        ``ahead`` is False (a read of the state: the caller calls :meth:`hold_wells_ahead` before the next relaxation)."""
         niter, events = relaxation.relax(self._backend, margin, record)
-        if niter and self.extend:
+        self._copies.changed()
+        if niter and self.extend and ahead:
             self.hold_wells_ahead()
         return niter, events
 
-    def backend_for(self, model):
-        """A backend prepared for another model on the stack's mesh and drive, with a state of its own (the linear
-        response's elastic twin; :meth:`.backends.base.Backend.for_model`)."""
-        return self._backend.for_model(model)
+    def backend_for(self, model, epsy):
+        """A backend for another model on the stack's mesh, its own state (:meth:`.backends.base.Backend.for_model`)."""
+        return self._backend.for_model(model, epsy)
 
     def push_yield_strains(self):
         """Give the backend the yield strains it holds anew (a modifier's state changed: :meth:`.window.HeldWindow.push`)."""
@@ -184,8 +217,8 @@ def stack_model(params, mesh, constants):
     Returns
     -------
     model : stickslip.fem.model.Model
-        Its ``epsy`` the windows' yield strains (a :class:`Stack` tells those held later, :attr:`Stack.yield_strains`).
     wells : HeldYieldStrains
+        Its yield strains those a :class:`Stack` gives its backend (:attr:`Stack.yield_strains`).
 
     Raises
     ------
@@ -201,8 +234,7 @@ def stack_model(params, mesh, constants):
     if narrowest <= constants["deps"]:
         raise SolverError("a well is narrower than the kick 'deps'; use a smaller 'deps' or larger 'eps_offset'")
     plastic = np.asarray(mesh.layer_is_plastic, dtype=bool)
-    model = build_model(mesh, epsy=wells.epsy,
-                        law=make_law(params.interface_law, params.K, params.G, params.law_params),
+    model = build_model(mesh, law=make_law(params.interface_law, params.K, params.G, params.law_params),
                         rho=params.rho, alpha=constants["alpha"], dt=constants["dt"], k_drive=params.k_drive,
                         drive_active=~plastic & (np.arange(mesh.nlayer) > 0), free_lever=params.drive == "free-lever",
                         lever_height=constants["H"])

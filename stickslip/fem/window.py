@@ -2,15 +2,19 @@
 
 Every block's sequence of yield strains is unbounded (:class:`.yield_strains.HeldYieldStrains`); the backend
 holds a window of it and numbers the wells from the window's start. :class:`HeldWindow` gives the backend those
-yield strains (through :meth:`.backends.base.Backend.set_yield_strains` only), widens the windows, and with
-``yield_strains = extend`` moves them ahead of the Gauss points (:meth:`HeldWindow.hold_ahead`). One
+yield strains (through :meth:`.backends.base.Backend.set_yield_strains` only: the backend's copy is the only one
+besides the window's own), widens the windows, and with
+``yield_strains = extend`` moves them ahead of the Gauss points (:meth:`HeldWindow.hold_ahead`); a checkpoint of
+the stack keeps the windows as they are (:meth:`HeldWindow.snapshot`) and its rollback returns to them. One
 **yield-strain modifier** may be registered (junction aging, :class:`.thermal.junctions.Junctions`): an object with
 ``modify(wells)`` (the yield strains the backend holds, float64 [ni, ny], from the windows), ``stored()`` (a dict of
-arrays, its state) and ``restore(stored)``. Part of the stack (:class:`.stack.Stack`), which shares its backend.
+arrays, its state) and ``restore(stored)``. Part of the stack (:class:`.stack.Stack`), which shares its backend and its
+host copies of the state (:class:`.host_copies.HostCopies`).
 """
 
 import numpy as np
 
+from .backends.base import read_only
 from .materials import equivalent_strains
 
 __all__ = ["HeldWindow"]
@@ -22,21 +26,28 @@ class HeldWindow:
     Parameters
     ----------
     backend : stickslip.fem.backends.base.Backend
-        The stack's backend (prepared).
+        The stack's backend (prepared); it is given the windows' yield strains at once.
     wells : stickslip.fem.yield_strains.HeldYieldStrains
         The held windows of the blocks' yield-strain sequences.
+    copies : stickslip.fem.host_copies.HostCopies
+        The stack's host copies of the backend's state.
 
     Attributes
     ----------
     wells : stickslip.fem.yield_strains.HeldYieldStrains
     modifier : object or None
         The registered yield-strain modifier (module docstring).
+    held : numpy.ndarray
+        float64 [ni, ny]: the yield strains the backend holds (given last), read only.
     """
 
-    def __init__(self, backend, wells):
+    def __init__(self, backend, wells, copies):
         self._backend = backend
+        self._copies = copies
         self.wells = wells
         self.modifier = None
+        self.held = None
+        self.push()
 
     def register(self, modifier):
         """Register the yield-strain modifier; the backend is given its yield strains at once.
@@ -61,6 +72,8 @@ class HeldWindow:
         """
         epsy = self.wells.epsy if self.modifier is None else self.modifier.modify(self.wells)
         self._backend.set_yield_strains(epsy, shift)
+        self._copies.changed()
+        self.held = read_only(epsy)
 
     def widen(self):
         """Hold twice as many wells per block (the window's start unchanged)."""
@@ -78,7 +91,7 @@ class HeldWindow:
         the physics: they are the same numbers wherever the window is.
         """
         wells = self.wells
-        idx, eps = self._backend.read("idx", "eps")
+        idx, eps = self._copies.read("idx", "eps")
         if np.any((wells.offset > 0) & (idx.min(axis=1) == 0)
                   & (equivalent_strains(eps).min(axis=1) <= wells.epsy[:, 0])):
             wells.start(wells.epsy.shape[1] - 1)
@@ -86,7 +99,7 @@ class HeldWindow:
         while True:
             ny = wells.epsy.shape[1]
             ahead, behind = (ny - 1) // 2, (ny - 1) // 4
-            idx, eps = self._backend.read("idx", "eps")
+            idx, eps = self._copies.read("idx", "eps")
             short = idx.max(axis=1) > ny - 1 - ahead
             if not short.any():
                 return
@@ -97,3 +110,12 @@ class HeldWindow:
                 continue
             wells.slide(shift)
             self.push(shift)
+
+    def snapshot(self):
+        """The windows and the yield strains held now (for :meth:`resume`)."""
+        return self.wells.snapshot(), self.held
+
+    def resume(self, snapshot):
+        """Return to a :meth:`snapshot` (the backend's own rollback returns it to the yield strains it held then)."""
+        self.wells.resume(snapshot[0])
+        self.held = snapshot[1]

@@ -211,7 +211,8 @@ class HeldYieldStrains:
     Attributes
     ----------
     epsy : numpy.ndarray
-        float64 [nelem, ny]: the held values (replaced by a wider array by :meth:`widen`).
+        float64 [nelem, ny]: the held values, never changed in place (every move gives a new array), so that what
+        was given out of it (to a backend, to a :meth:`snapshot`) keeps its values.
     offset : numpy.ndarray
         int64 [nelem]: global index of ``epsy[:, 0]``.
     """
@@ -239,8 +240,9 @@ class HeldYieldStrains:
         shift : numpy.ndarray
             int64 [nelem] values to drop at the front of each window (0: unchanged).
         """
-        _slide(self.epsy, self.offset, np.asarray(shift, dtype=np.int64), self.state, self.inc, self.last,
-               *self._constants)
+        epsy = self.epsy.copy()
+        _slide(epsy, self.offset, np.asarray(shift, dtype=np.int64), self.state, self.inc, self.last, *self._constants)
+        self.epsy = epsy
 
     def widen(self, extra):
         """Hold ``extra`` more values per element (appended; ``epsy`` becomes a new array)."""
@@ -249,3 +251,12 @@ class HeldYieldStrains:
         wider[:, :ny] = self.epsy
         _fill(wider, np.full(nelem, ny, dtype=np.int64), self.state, self.inc, self.last, *self._constants)
         self.epsy = wider
+
+    def snapshot(self):
+        """What :meth:`resume` returns to: the windows and their generators now (a tuple; the held values shared)."""
+        return self.epsy, self.offset.copy(), self.state.copy(), self.inc.copy(), self.last.copy()
+
+    def resume(self, snapshot):
+        """Return to a :meth:`snapshot`: the same windows, the same values to be drawn next."""
+        self.epsy = snapshot[0]
+        self.offset, self.state, self.inc, self.last = (array.copy() for array in snapshot[1:])

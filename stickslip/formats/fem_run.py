@@ -31,7 +31,7 @@ equal runs give equal bytes):
     Scaled linear response: ``delta_u`` [ndof], ``delta_eps`` [ni, 4, 3],
     ``delta_target`` [nlayer], ``delta_lever`` [1].
 ``/state``
-    One row per increment, enough to restore it: ``u`` [ninc, ndof], ``target``
+    One row per increment, enough to restore it (:class:`StoredState`): ``u`` [ninc, ndof], ``target``
     [ninc, nlayer], ``lever_target`` [ninc], ``t`` [ninc]; and any further state the producer
     declares (``create_file``'s ``state_fields``, e.g. ``fem`` with junction aging:
     ``junction_depth``, ``junction_well`` [ninc, ni]), which files without it lack.
@@ -49,18 +49,21 @@ consumers read them from here and never recompute them.
 
 import json
 import numbers
+from types import MappingProxyType
+from typing import Mapping, NamedTuple
 
 import h5py
 import numpy as np
 
 from .. import __version__, formats
 from ..arithmetic import check_resume, decisive
-from ..h5io import (FileFormatError, attribute, copy_file, open_file, read_array, read_table, write_attrs,
-                    write_dataset)
+from ..h5io import (CorruptFileError, FileFormatError, attribute, copy_file, open_file, read_array, read_table,
+                    write_attrs, write_dataset)
 from ..mesh import load_mesh, save_mesh
 from ..output_safety.atomic import atomic_output
+from ..stored_rows import first_unstored_row
 
-__all__ = ["FORMAT", "HEADER", "REGIMES", "create_file", "append_increment", "rewrite", "read_params",
+__all__ = ["FORMAT", "HEADER", "REGIMES", "StoredState", "create_file", "append_increment", "rewrite", "read_params",
            "read_increments", "read_run_attrs", "stored_increments", "RunFile", "describe", "check_arithmetic"]
 
 #: The format name of these files (:mod:`stickslip.formats`).
@@ -92,6 +95,33 @@ HEADER = {
 
 _KINDS = {"int": (numbers.Integral,), "float": (numbers.Real,), "str": (str,), "json": (dict,)}
 
+
+
+class StoredState(NamedTuple):
+    """One stored increment's state: what restores it (``/state``), the record that writers, readers and producers share.
+
+    Attributes
+    ----------
+    u : numpy.ndarray
+        float64 [ndof] displacement [length].
+    target : numpy.ndarray
+        float64 [nlayer] drive targets of the layers [length].
+    lever_target : float
+        The free lever's drive target [length] (0 for a fixed lever).
+    t : float
+        Time [time].
+    further : Mapping[str, numpy.ndarray]
+        The producer's further state (``create_file``'s ``state_fields``) by dataset name; empty without it.
+    """
+
+    u: object
+    target: object
+    lever_target: float
+    t: float
+    further: Mapping = MappingProxyType({})
+
+
+#: The datasets of every file's stored state, by :class:`StoredState` field.
 _STATE = ("u", "target", "lever_target", "t")
 
 
@@ -127,7 +157,7 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
         Types of columns that are neither float64 nor the well counts ``S_*``, ``A_*`` (int64).
     state_fields : Mapping[str, tuple], optional
         Further state stored per increment: name -> ``(shape, dtype)`` of one increment's value
-        (datasets ``/state/<name>``; :func:`append_increment` takes their values as a fifth item).
+        (datasets ``/state/<name>``; :func:`append_increment` takes their values as :attr:`StoredState.further`).
     arithmetic : Mapping[str, object], optional
         What decides the bits beside :func:`stickslip.arithmetic.decisive` (a device backend's GPU,
         :func:`stickslip.fem.backends.backend_arithmetic`), recorded with it in ``arithmetic``.
@@ -183,15 +213,14 @@ def append_increment(file, state, row):
     Parameters
     ----------
     file : h5py.File
-    state : tuple
-        ``(u [ndof], target [nlayer], lever_target, t)``: what restores the increment; with further
-        state (``create_file``'s ``state_fields``) a fifth item, a mapping of their values.
+    state : StoredState
+        What restores the increment (its ``further`` the values of ``create_file``'s ``state_fields``).
     row : dict
         ``increment``, ``kick``, ``yield_element`` and the observables.
     """
-    for name, value in zip(_STATE, state):
-        _append(file["state"][name], value)
-    for name, value in (state[4] if len(state) > 4 else {}).items():
+    for name in _STATE:
+        _append(file["state"][name], getattr(state, name))
+    for name, value in state.further.items():
         _append(file["state"][name], value)
     table = file["increments"]
     for name in json.loads(table.attrs["columns"]):
@@ -218,7 +247,7 @@ def rewrite(path, **attrs):
         Root attributes to set in the copy (e.g. ``completed``, ``stop_reason``).
     """
     with open_file(path) as source, atomic_output(path) as tmp:
-        _check(source)
+        RunFile(source)  # header, mesh, the arrays' shapes and the stored rows checked before a byte is copied
         with open_file(tmp, "w") as target:
             copy_file(source, target, rows=stored_increments(source))
             write_attrs(target, attrs)
@@ -271,12 +300,20 @@ def _check(file):
 
 
 def stored_increments(file):
-    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``).
+    """The number of complete increments an open ``fem-run`` file says it stores (``nstored``), checked against its
+    datasets.
+
+    Every growable dataset of ``/state`` and ``/increments`` must hold ``nstored`` rows, and the file must store
+    the last of them (its chunk was written, :mod:`stickslip.stored_rows`): a file resized and told a larger
+    ``nstored`` is refused here, before any row is read, in a few lookups of each chunk index (a chunk missing
+    before the last is refused where the rows are read, :func:`stickslip.h5io.read_array`).
 
     Raises
     ------
     FileFormatError
         If ``nstored`` is not an integer >= 0, or more than the file's rows (``/state/t``).
+    stickslip.h5io.CorruptFileError
+        If a growable dataset holds fewer rows or the file does not store its row ``nstored - 1``.
     """
     nstored = attribute(file, "nstored", "int")
     times = file.get("state/t")
@@ -285,7 +322,23 @@ def stored_increments(file):
     if not 0 <= nstored <= times.shape[0]:
         raise FileFormatError(f"{file.filename}: attribute 'nstored' is {nstored}, expected 0 ... the "
                               f"{times.shape[0]} rows of /state/t")
+    growable = _growable(file) if nstored else []
+    if any(dataset.shape[0] < nstored or first_unstored_row(dataset, nstored - 1, nstored) is not None
+           for dataset in growable):
+        stored = {dataset.name: min(dataset.shape[0], first_unstored_row(dataset, 0, nstored) or nstored)
+                  for dataset in growable}
+        name = min(stored, key=stored.get)
+        raise CorruptFileError(f"{file.filename}: attribute 'nstored' is {nstored}, but {name} stores {stored[name]} "
+                               f"rows at most (declared: {file[name].shape[0]}): the file is damaged or not what it "
+                               "claims; remake it (rerun the job that wrote it)")
     return nstored
+
+
+def _growable(file):
+    """The datasets of ``/state`` and ``/increments`` with an unlimited first axis (one row per increment)."""
+    groups = [file.get(name) for name in ("state", "increments")]
+    return [item for group in groups if isinstance(group, h5py.Group) for item in group.values()
+            if isinstance(item, h5py.Dataset) and item.maxshape and item.maxshape[0] is None]
 
 
 def read_params(file):
@@ -338,15 +391,34 @@ class RunFile:
         self.params = read_params(file)
         self.mesh = load_mesh(file["mesh"])
         self.nstored = stored_increments(file)
+        self._check_shapes()
+
+    def _check_shapes(self):
+        """Raise FileFormatError unless the linear response and the state have the shapes of the mesh (module
+        docstring), before any of them is used."""
+        ndof, nlayer = self.mesh.ndof, self.mesh.nlayer
+        expected = {"event/delta_u": (ndof,), "event/delta_eps": (self.mesh.N * self.mesh.n_interfaces, 4, 3),
+                    "event/delta_target": (nlayer,), "event/delta_lever": (1,), "state/u": (ndof,),
+                    "state/target": (nlayer,), "state/lever_target": (), "state/t": ()}
+        for name, shape in expected.items():
+            dataset = self.file.get(name)
+            per_row = name.startswith("state/")
+            found = dataset.shape if isinstance(dataset, h5py.Dataset) else None
+            found = (found[1:] if found else None) if per_row else found
+            if found != shape:
+                what = f"of shape {dataset.shape}" if isinstance(dataset, h5py.Dataset) else "missing"
+                raise FileFormatError(f"{self.file.filename}: /{name} is {what}, expected "
+                                      f"{'rows of ' if per_row else ''}{shape} (the stored mesh's): the file is "
+                                      "damaged")
 
     def state(self, increment):
-        """(u, target, lever_target, t) of a stored increment; a file with further state adds a mapping of it."""
+        """The :class:`StoredState` of a stored increment (its ``further`` empty in a file without further state)."""
         if not 0 <= increment < self.nstored:
             raise FileFormatError(f"{self.file.filename}: increment {increment} is not stored "
                                   f"(0 ... {self.nstored - 1})")
         u, target, lever_target, t = (read_array(self.file["state"][name], increment) for name in _STATE)
         further = {name: read_array(self.file["state"][name], increment) for name in self._further()}
-        return (u, target, float(lever_target), float(t)) + ((further,) if further else ())
+        return StoredState(u, target, float(lever_target), float(t), further)
 
     def _further(self):
         return [name for name in sorted(self.file["state"]) if name not in _STATE]

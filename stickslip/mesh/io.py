@@ -8,8 +8,11 @@ Layout of a mesh group: datasets ``coor`` [nnode, 2], ``conn`` [nelem, 4],
 
 from pathlib import Path
 
+import h5py
+import numpy as np
+
 from .. import formats
-from ..h5io import FileFormatError, open_file, read_array, write_attrs, write_dataset
+from ..h5io import FileFormatError, attribute, open_file, read_array, write_attrs, write_dataset
 from ..hashing import short_hash
 from ..output_safety.atomic import atomic_output
 from ..plugin_params import ParameterError, params_to_dict, parse_params
@@ -20,7 +23,7 @@ __all__ = ["MESH_FORMAT", "mesh_id", "save_mesh", "load_mesh", "read_mesh_params
 #: Version of the mesh geometry and file layout (format ``mesh``); part of every mesh id.
 MESH_FORMAT = formats.get_format("mesh").version
 
-_DATASETS = {"coor": 2, "conn": 2, "dofs": 2, "iip": 1, "elem_layer": 1, "layer_y": 2, "interface_elements": 2}
+_DATASETS = ("coor", "conn", "dofs", "iip", "elem_layer", "layer_y", "interface_elements")
 
 
 def mesh_id(params):
@@ -66,23 +69,47 @@ def load_mesh(group):
     Raises
     ------
     FileFormatError
-        If a dataset or attribute is missing, has the wrong rank, or the format
-        version is not :data:`MESH_FORMAT`; the message names file, group and item.
+        If a dataset or attribute is missing, the format version is not :data:`MESH_FORMAT`, or the arrays are not
+        the mesh of the stored ``N``, ``plates`` and ``h`` (:func:`~stickslip.mesh.layered.build_stack_mesh` of them,
+        exactly: a mesh is determined by its parameters, so a damaged one is refused before it is used; their
+        declared shapes are checked before a number is read); the message names file, group and item.
     """
     where = f"{group.file.filename}:{group.name}"
-    missing = [name for name in _DATASETS if name not in group]
+    missing = [name for name in _DATASETS if not isinstance(group.get(name), h5py.Dataset)]
     missing += [name for name in ("N", "plates", "h", "mesh_format") if name not in group.attrs]
     if missing:
         raise FileFormatError(f"{where}: not a stickslip mesh, missing {', '.join(missing)}")
-    if int(group.attrs["mesh_format"]) != MESH_FORMAT:
+    if attribute(group, "mesh_format", "int") != MESH_FORMAT:
         raise FileFormatError(f"{where}: mesh_format {group.attrs['mesh_format']} is not the supported "
                               f"{MESH_FORMAT}; rebuild the mesh")
+    params = read_mesh_params(group)
+    _check_shapes(where, {name: group[name].shape for name in _DATASETS}, params)
     arrays = {name: read_array(group[name]) for name in _DATASETS}
-    for name, rank in _DATASETS.items():
-        if arrays[name].ndim != rank:
-            raise FileFormatError(f"{where}/{name}: expected {rank} dimensions, got shape {arrays[name].shape}")
-    return LayeredMesh(**arrays, N=int(group.attrs["N"]), plates=int(group.attrs["plates"]),
-                       h=float(group.attrs["h"]))
+    expected = build_stack_mesh(params)
+    for name in _DATASETS:
+        if not np.array_equal(arrays[name], getattr(expected, name)):
+            raise FileFormatError(f"{where}/{name}: not the mesh of N = {params.N}, plates = {params.plates}, h = "
+                                  f"{params.h:g} (mesh format {MESH_FORMAT}) that the file names: the file is damaged")
+    return expected
+
+
+#: Elements of the stack's mesh per block and plate, at most (11 per block and interface for N >= 54).
+_ELEMENTS_PER_BLOCK = 20
+
+
+def _check_shapes(where, shapes, params):
+    """Raise FileFormatError unless the declared shapes of the mesh arrays fit each other and the mesh's N and
+    plates (before any is read, and before the mesh of N and plates is built to compare them with)."""
+    nnode, nelem = (shapes[name][0] if shapes[name] else 0 for name in ("coor", "conn"))
+    expected = {"coor": (nnode, 2), "conn": (nelem, 4), "dofs": (nnode, 2), "elem_layer": (nelem,),
+                "iip": shapes["iip"] if len(shapes["iip"]) == 1 and shapes["iip"][0] <= 2 * nnode else (2 * nnode,),
+                "layer_y": (2 * params.plates - 1, 2), "interface_elements": (params.plates - 1, params.N)}
+    wrong = [name for name, shape in expected.items() if shapes[name] != shape]
+    if not params.N * (params.plates - 1) <= nelem <= _ELEMENTS_PER_BLOCK * params.N * params.plates:
+        wrong.append("conn")
+    if wrong:
+        raise FileFormatError(f"{where}/{wrong[0]}: shape {shapes[wrong[0]]} does not fit a mesh of N = {params.N}, "
+                              f"plates = {params.plates} with the other arrays' shapes: the file is damaged")
 
 
 def read_mesh_params(group):

@@ -15,6 +15,7 @@ file too damaged to open (a truncated copy) is moved aside, never deleted (:func
 """
 
 import errno
+import filecmp
 import glob
 import json
 import os
@@ -176,7 +177,7 @@ def _difference(stored, identity, describe):
     return None
 
 
-def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe=_description):
+def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe=_description, damage=None):
     """Raise :class:`OutputExistsError` if ``path`` exists and holds another run than ``identity``.
 
     Parameters
@@ -193,6 +194,10 @@ def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe
         this run.
     describe : callable, optional
         ``describe(stored) -> str``: what the stored values say the file is.
+    damage : callable, optional
+        ``damage(stored) -> str or None``: why stored values that differ from ``identity`` cannot be those
+        of any run of this writer (a damaged file: a parameter no run has), or None; the message then says
+        the file is damaged, not another run.
 
     Returns
     -------
@@ -217,12 +222,13 @@ def refuse_other_run(path, identity, *, hint=OVERWRITE_HINT, read=None, describe
                                       "a readable HDF5 file)", hint) from None
     difference = _difference(stored, identity, describe)
     if difference is not None:
-        raise OutputExistsError(path, difference, hint)
+        why = damage(stored) if damage is not None else None
+        raise OutputExistsError(path, f"holds {describe(stored)} that is damaged: {why}" if why else difference, hint)
     return True
 
 
 @contextmanager
-def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
+def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT, damage=None):
     """The one rule of the command line: write ``path`` in the block only if it is absent, this run, or ``overwrite``.
 
     Before the block: an absent output or one that holds this run (:func:`refuse_other_run`) is
@@ -243,6 +249,8 @@ def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
         Replace another run (``--overwrite``).
     hint : str, optional
         The end of the refusal's message: how to overwrite (default: the command line's ``--overwrite``).
+    damage : callable, optional
+        Why a differing output is damaged rather than another run (:func:`refuse_other_run`).
 
     Raises
     ------
@@ -255,7 +263,7 @@ def claimed_output(path, identity, *, overwrite=False, hint=OVERWRITE_HINT):
         print(f"stickslip: {path}: not a readable HDF5 file; moved it to {aside}, starting the run over",
               file=sys.stderr)
     try:
-        refuse_other_run(path, identity, hint=hint)
+        refuse_other_run(path, identity, hint=hint, damage=damage)
     except OutputExistsError as error:
         if not overwrite:
             raise
@@ -294,8 +302,8 @@ def write_text_output(path, text, *, overwrite=False):
     Parameters
     ----------
     path : str or pathlib.Path
-    text : str
-        The whole content (UTF-8).
+    text : str or Iterable[str]
+        The whole content (UTF-8), or its pieces in order (written as they come: the text is never held whole).
     overwrite : bool, optional
 
     Returns
@@ -306,13 +314,14 @@ def write_text_output(path, text, *, overwrite=False):
     Raises
     ------
     OutputExistsError
-        If ``path`` exists with other content and ``overwrite`` is false.
+        If ``path`` exists with other content and ``overwrite`` is false (the new text is then discarded).
     """
     path = Path(path)
-    data = text.encode()
-    replaced = path.exists() and (path.is_dir() or path.read_bytes() != data)
-    if replaced and not overwrite and not path.is_dir():
-        raise OutputExistsError(path, "exists with other content", OVERWRITE_HINT)
     with atomic_output(path) as tmp:
-        tmp.write_bytes(data)
+        with open(tmp, "w", encoding="utf-8", newline="") as stream:
+            for piece in [text] if isinstance(text, str) else text:
+                stream.write(piece)
+        replaced = path.exists() and (path.is_dir() or not filecmp.cmp(tmp, path, shallow=False))
+        if replaced and not overwrite and not path.is_dir():
+            raise OutputExistsError(path, "exists with other content", OVERWRITE_HINT)
     return replaced

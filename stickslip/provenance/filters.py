@@ -11,6 +11,11 @@ of returning an empty table. A value may be:
 - a list, tuple or set of values: rows equal to any of them (``n=[1, 2]``);
 - a float column: a pair ``(low, high)`` tuple also means the closed range (``phi=(1e-6, 1e-3)``).
 
+numpy scalars and arrays are taken as the Python values they hold (``n=df["n"].unique()[0]``), and an integer
+column takes a float with an integer value (``n=3.0``); a value that no row can hold (``n=3.5``, ``n="3"``) is
+refused, never answered with an empty table. ``a`` is the interface (the paper's a, 1 = lowest; ``events(a=1)`` is
+``events(interface=1)``); the slab driven alone in the individual protocol is ``driven_slab``.
+
 The database's text columns that name plugins (``solver``, ``analysis``, ``plugin``) are checked against the
 values the database holds.
 """
@@ -20,6 +25,9 @@ import inspect
 import math
 import numbers
 from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
 
 from ..plugin_params import ParameterError, did_you_mean
 from ..vocabulary import QUANTITIES
@@ -106,15 +114,27 @@ def _fail(name, message):
     raise ParameterError(f"filter '{name}': {message}")
 
 
+def _python(value):
+    """A numpy scalar (``df["n"].unique()`` hands them out) as the Python value SQLite binds; others as given.
+
+    (sqlite3 binds a numpy integer as a blob, which equals no number: the query would return nothing.)
+    """
+    return value.item() if isinstance(value, np.generic) else value
+
+
 def _scalar(spec, value):
-    """One value checked against the filter's kind (ints for floats allowed)."""
+    """One value checked against the filter's kind and made a Python value (ints for floats allowed; a float with
+    an integer value, e.g. from a column with missing values, for ints)."""
+    value = _python(value)
+    if spec.kind == "int" and isinstance(value, float) and value.is_integer():
+        value = int(value)
     kinds = {"int": (numbers.Integral,), "float": (numbers.Real,), "str": (str,), "bool": (bool,)}[spec.kind]
     if not isinstance(value, kinds) or (spec.kind in ("int", "float") and isinstance(value, bool)):
         expected = {"int": "an integer", "float": "a number", "str": "a string", "bool": "True or False"}[spec.kind]
-        _fail(spec.name, f"expected {expected} (or a list of them), got {value!r}")
+        _fail(spec.name, f"expected {expected} (or a list of them), got {value!r}: no row can match it")
     if spec.kind == "float" and not math.isfinite(value):
         _fail(spec.name, f"expected a finite number, got {value!r}")
-    return float(value) if spec.kind == "float" else value
+    return float(value) if spec.kind == "float" else int(value) if spec.kind == "int" else value
 
 
 def _checked(spec, value, known):
@@ -124,7 +144,8 @@ def _checked(spec, value, known):
         if low > high:
             _fail(spec.name, f"a range (low, high) needs low <= high, got {value!r}")
         return "range", (low, high)
-    items = list(value) if isinstance(value, (list, tuple, set, frozenset)) else [value]
+    items = list(value) if isinstance(value, (list, tuple, set, frozenset, np.ndarray, pd.Series, pd.Index)) \
+        else [value]
     if not items:
         _fail(spec.name, "an empty list selects nothing")
     items = [_scalar(spec, item) for item in items]
@@ -170,13 +191,16 @@ def check(specs, filters, *, known=None, parameters=None):
     for name, value in filters.items():
         if value is None:
             continue
+        if name == "a" and "interface" in by_name:  # the paper's a: the interface, as in S_a1, A_a1
+            name = "interface"
         if name in by_name:
             out.append((by_name[name],) + _checked(by_name[name], value, known or {}))
             continue
         declared = (parameters or {}).get(name)
         if not declared:
             hint = " (the fem parameter N is the column blocks)" if name == "N" else \
-                " (the lever parameter a is the column driven_slab)" if name == "a" else did_you_mean(name, by_name)
+                (" (a is the interface, a filter of events(); the slab driven alone in the individual protocol is "
+                 "driven_slab)") if name == "a" else did_you_mean(name, by_name)
             raise ParameterError(f"unknown filter {name!r}{hint}; allowed: {', '.join(by_name)}, or a parameter "
                                  "of a plugin (stickslip.params(name))")
         if isinstance(value, (list, tuple, set, frozenset, Mapping)):
@@ -254,10 +278,13 @@ def with_filters(specs):
     """Decorate ``method(self, **filters)`` with an explicit keyword signature and docs of ``specs``.
 
     ``help()``, IPython's ``?`` and tab completion show every filter; the method still receives them as
-    ``**filters`` (None where not given), with plugin parameters among them.
+    ``**filters`` (None where not given), with plugin parameters among them. The method's own keyword-only
+    parameters (``wide``) come first.
     """
     def decorate(method):
-        parameters = [inspect.Parameter("self", inspect.Parameter.POSITIONAL_OR_KEYWORD)]
+        own = [parameter for parameter in inspect.signature(method).parameters.values()
+               if parameter.kind is inspect.Parameter.KEYWORD_ONLY]
+        parameters = [inspect.Parameter("self", inspect.Parameter.POSITIONAL_OR_KEYWORD), *own]
         parameters += [inspect.Parameter(spec.name, inspect.Parameter.KEYWORD_ONLY, default=None) for spec in specs]
         parameters.append(inspect.Parameter("parameters", inspect.Parameter.VAR_KEYWORD))
         method.__signature__ = inspect.Signature(parameters)

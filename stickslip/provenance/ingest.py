@@ -25,6 +25,7 @@ import shutil
 from contextlib import contextmanager
 from pathlib import Path
 
+import sqlalchemy.exc
 from sqlalchemy import delete, insert
 from sqlalchemy.orm import Session
 
@@ -217,6 +218,23 @@ def ingest(database, records, *, rebuild=False):
             with Session(engine) as session, session.begin():
                 for record_file in iterate(records, desc="ingest", unit="record"):
                     events += _ingest_record(session, read_record(record_file), record_file)
+        except (sqlalchemy.exc.DatabaseError, UnicodeDecodeError) as error:
+            raise _database_error(database, error) from None
         finally:
             engine.dispose()
     return {"records": len(records), "slip events": events}
+
+
+#: SQLite's words for a file that is not a database, or a damaged one (a text value that is not UTF-8 is damage too:
+#: SQLite keeps no checksums).
+_DAMAGED = ("file is not a database", "malformed", "corrupt")
+
+
+def _database_error(database, error):
+    """The one-line error of SQLite failing on ``database`` during an ingest (the database is left as it was)."""
+    cause = str(getattr(error, "orig", None) or error).strip()
+    if isinstance(error, UnicodeDecodeError) or any(word in cause for word in _DAMAGED):
+        return FileFormatError(f"{database}: not a readable SQLite database ({cause}): it is damaged or not a "
+                               "database; `stickslip db rebuild` remakes it from the provenance records (left as it "
+                               "was)")
+    return FileFormatError(f"{database}: the ingest failed in SQLite ({cause}); the database is left as it was")

@@ -21,6 +21,7 @@ import _sqlite3
 import ctypes
 import dataclasses
 import itertools
+import json
 import math
 import numbers
 import signal
@@ -37,13 +38,14 @@ from sqlalchemy import select, text
 
 from .. import registry
 from ..h5io import FileFormatError
-from ..plugin_params import parse_value
-from ..vocabulary import dtype_matches, expand_json, quantity, typed
+from ..plugin_params import params_to_dict, parse_value
+from ..vocabulary import UnitFrame, dtype_matches, expand_json, missing_as_na, quantity, typed
 from . import filters as _filters
 from .database import SCHEMA_HINT, SCHEMA_VERSION, Figure, Run, SlipEvent, engine_for
 
-__all__ = ["DEFAULT_DATABASE", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S", "MAX_ROWS",
-           "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "check_bounds"]
+__all__ = ["DEFAULT_DATABASE", "RUN_COLUMNS", "QueryError", "READ_ONLY_PRAGMAS", "DENIED_FUNCTIONS", "TIME_LIMIT_S",
+           "MAX_ROWS", "MEMORY_LIMIT_MIB", "CHECK_EVERY", "runs", "events", "figures", "sql", "sql_pieces", "Pieces",
+           "unique_names", "check_bounds"]
 
 #: Where the workflow writes the database of the default study (relative to the workflow directory);
 #: a study named S has ``results/S/stickslip.sqlite``.
@@ -196,10 +198,16 @@ class _Bounds:
             if self.stop == "interrupt":
                 raise KeyboardInterrupt
 
-    def take(self, piece):
-        """Count a piece of fetched rows; raise QueryError past a bound (rows, bytes, time)."""
+    def take(self, piece, columns, kept=True):
+        """Count a piece of fetched rows; raise QueryError past a bound (rows, bytes, time).
+
+        ``kept``: the rows stay in memory until the query ends and a table of ``columns`` is made of them (their
+        bytes add up, with 16 bytes a value for the table); else only the piece is held (a stream: it is
+        bounded alone).
+        """
         self.rows += len(piece)
-        self.bytes += _row_bytes(piece)
+        held = _row_bytes(piece) + (16 * len(piece) * len(columns) if kept else 0)
+        self.bytes = self.bytes + held if kept else held
         if self.max_rows is not None and self.rows > self.max_rows:
             raise QueryError(f"the query returns more than {self.max_rows} rows (the bound on rows: add LIMIT, or "
                              f"raise it with `db sql --max-rows N`, max_rows= in Python)")
@@ -231,27 +239,56 @@ def _row_bytes(rows):
     return sum(map(sys.getsizeof, values)) + sum(map(sys.getsizeof, rows))
 
 
-def _rows(connection, statement, bounds):
-    """The rows of ``statement`` as a DataFrame, fetched in pieces that the bounds count (:meth:`_Bounds.take`).
+def unique_names(names):
+    """Column names made unique: a name seen before gets ``.1``, ``.2``, ... (as :func:`pandas.read_csv` does).
+
+    Parameters
+    ----------
+    names : Iterable[str]
+
+    Returns
+    -------
+    list[str]
+    """
+    seen, out = set(), []
+    for name in map(str, names):
+        unique, k = name, 0
+        while unique in seen:
+            k += 1
+            unique = f"{name}.{k}"
+        seen.add(unique)
+        out.append(unique)
+    return out
+
+
+class Pieces:
+    """The rows of a running query, fetched in pieces that its bounds count (:meth:`_Bounds.take`).
 
     A piece holds up to :data:`_FETCH` rows and about :data:`_PIECE_BYTES`: rows of large values (blobs) are
-    fetched a few at a time, so that no piece passes the memory bound by much.
+    fetched a few at a time, so that no piece passes the memory bound by much. The time between two pieces
+    (what the reader does with one) counts against the time limit.
+
+    Attributes
+    ----------
+    columns : list[str]
+        The result's column names, made unique (:func:`unique_names`).
     """
-    result = connection.execute(statement)
-    columns = list(result.keys())
-    rows, size = [], 16
-    while True:
-        piece = result.fetchmany(size)
-        try:
-            bounds.take(piece)
-        except BaseException:
-            result.close()
-            raise
-        rows += piece
-        if len(piece) < size:
-            return pd.DataFrame.from_records(rows, columns=columns, coerce_float=True)
-        row_bytes = max(1, _row_bytes(piece) // len(piece))
-        size = int(min(_FETCH, max(1, _PIECE_BYTES // row_bytes)))
+
+    def __init__(self, result, bounds, kept):
+        self._result, self._bounds, self._kept = result, bounds, kept
+        self.columns = unique_names(result.keys())
+
+    def __iter__(self):
+        """Lists of row tuples, in order; the last may be empty."""
+        size = 16
+        while True:
+            piece = self._result.fetchmany(size)
+            self._bounds.take(piece, self.columns, self._kept)
+            yield piece
+            if len(piece) < size:
+                return
+            row_bytes = max(1, _row_bytes(piece) // len(piece))
+            size = int(min(_FETCH, max(1, _PIECE_BYTES // row_bytes)))
 
 
 def check_bounds(time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS, memory_limit_mib=MEMORY_LIMIT_MIB):
@@ -276,7 +313,13 @@ def check_bounds(time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS, memory_limit_mib=ME
             number("memory_limit_mib", "--memory-limit MIB", memory_limit_mib))
 
 
-def _frame(database, statement, only_reading=False, time_limit=None, max_rows=None, memory_limit_mib=None):
+@contextmanager
+def _pieces(database, statement, only_reading=False, time_limit=None, max_rows=None, memory_limit_mib=None, kept=True):
+    """Run ``statement`` under the bounds; the block reads its rows from the :class:`Pieces` it is given.
+
+    Every failure of the query, its bounds included, also while the block reads the rows, ends as one
+    :class:`QueryError` naming the database (Ctrl-C as KeyboardInterrupt).
+    """
     engine = _engine(database)
     bounds = _Bounds(time_limit, max_rows, memory_limit_mib)
     try:
@@ -287,7 +330,11 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
                 if only_reading:
                     driver.set_authorizer(_only_reading)
                 try:
-                    frame = _rows(connection, statement, bounds)
+                    result = connection.execute(statement)
+                    try:
+                        yield Pieces(result, bounds, kept)
+                    finally:
+                        result.close()
                 finally:
                     driver.set_authorizer(None)
     except _Stopped:
@@ -298,6 +345,8 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
         raise QueryError(f"{database}: the statement returns no rows; `db sql` runs queries (SELECT)") from None
     except QueryError as error:
         raise QueryError(f"{database}: {error}") from None
+    except UnicodeDecodeError as error:  # SQLite keeps no checksums: a flipped bit in a text value
+        raise _damaged(database, f"{error.reason} at byte {error.start}") from None
     except MemoryError:  # SQLITE_NOMEM at the heap limit, or the machine's memory
         if not _HEAP.exhausted(bounds.memory):
             raise QueryError(f"{database}: the machine ran out of memory during the query, after {bounds.rows} rows "
@@ -309,11 +358,26 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
         bound = bounds.error(database, cause)
         if bound is not None:
             raise bound from None
+        if "decode to UTF-8" in str(cause):  # a text value of a column the driver decodes itself
+            raise _damaged(database, str(cause).split(" with text ")[0]) from None
         if "authoriz" in str(cause):  # "not authorized", "authorization denied"
             cause = f"refused ({cause}): `db sql` only reads (SELECT, WITH, PRAGMA {', '.join(READ_ONLY_PRAGMAS)})"
         raise QueryError(f"{database}: query failed: {cause}") from None
     finally:
         engine.dispose()
+
+
+def _damaged(database, detail):
+    """The QueryError of a text value that is not UTF-8 (SQLite keeps no checksums: a flipped bit in a value)."""
+    return QueryError(f"{database}: a text value is not UTF-8 ({detail}): the database is damaged; `stickslip db "
+                      "rebuild` remakes it from the provenance records")
+
+
+def _frame(database, statement, **bounds):
+    """The rows of ``statement`` as one typed DataFrame, the rows and the table counted by the bounds."""
+    with _pieces(database, statement, **bounds) as pieces:
+        rows = [row for piece in pieces for row in piece]
+        frame = pd.DataFrame.from_records(rows, columns=pieces.columns, coerce_float=True)
     return typed(frame)
 
 
@@ -321,6 +385,12 @@ def _frame(database, statement, only_reading=False, time_limit=None, max_rows=No
 SIMULATION_COLUMNS = ("solver", "source", "format", "path", "protocol", "n", "driven_slab", "plates", "blocks",
                       "k_drive", "phi", "regime", "temperature", "attempt_rate", "drive_rate", "junction_strengthening",
                       "junction_glass_temperature", "junction_attempt_rate")
+
+#: The columns of the narrow form of ``runs()`` (:meth:`stickslip.study_results.StudyResults.runs`; ``stickslip db
+#: runs`` in table format): who ran, on what physics, at what cost, from which commit.
+RUN_COLUMNS = ("run_id", "kind", "plugin", "plugin_version", "solver", "source", "protocol", "n", "driven_slab",
+               "plates", "blocks", "k_drive", "phi", "regime", "temperature", "seed", "wall_time_s", "peak_memory_mib",
+               "finished_at", "git_commit", "git_dirty")
 
 #: The tables of the filters whose values the database holds (``choices="database"``).
 _HELD = {"plugin": "runs", "solver": "simulations", "analysis": "slip_events"}
@@ -352,13 +422,33 @@ def _checked(database, specs, filters):
 
 
 def _units(frame):
-    """``attrs["units"]`` of a query's frame: the vocabulary's unit of every column in the vocabulary's dtype."""
+    """A query's frame as a :class:`~stickslip.vocabulary.UnitFrame`, its missing values ``pd.NA``
+    (:func:`~stickslip.vocabulary.missing_as_na`), ``attrs["units"]`` the vocabulary's unit of every column in the
+    vocabulary's dtype."""
+    frame = UnitFrame(missing_as_na(frame))
     units = {}
     for column in frame.columns:
         found = quantity(column)
         units[str(column)] = found.unit if found is not None and dtype_matches(frame[column].dtype, found.dtype) \
             else None
     frame.attrs["units"] = units
+    return frame
+
+
+def _defaults_filled(frame):
+    """``frame`` (columns ``kind``, ``plugin``, ``params``: JSON) with every parameter of a registered plugin in its
+    ``params``: one that a run's record leaves out (an extension at its default, a parameter added after the run was
+    made) gets its default, so that it is shown as the value it had (``interface_law`` "cusp"), not as missing.
+
+    Rows of a plugin not registered here (a mesh, another package's plugin not installed) are left as they are.
+    """
+    defaults = {}
+    for kind, plugin in set(zip(frame["kind"], frame["plugin"])):
+        if kind in registry.KINDS and plugin in registry.available(kind):
+            defaults[kind, plugin] = params_to_dict(registry.get(kind, plugin).params(), every=True)
+    frame["params"] = [text if (kind, plugin) not in defaults or not isinstance(text, str)
+                       else json.dumps({**defaults[kind, plugin], **json.loads(text)})
+                       for kind, plugin, text in zip(frame["kind"], frame["plugin"], frame["params"])]
     return frame
 
 
@@ -381,7 +471,8 @@ def runs(database=DEFAULT_DATABASE, **filters):
         (``code_hash``, ``package_version``, ``git_commit``, ``git_dirty``, ``python_version``, ...,
         ``host``), ``started_at``, ``finished_at`` (UTC datetimes), ``wall_time_s``, ``peak_memory_mib``,
         ``record_path``, then one column ``params.<name>`` per parameter of the runs' plugins (missing where a
-        plugin has no such parameter). Typed (:func:`stickslip.vocabulary.typed`), ``attrs["units"]``
+        plugin has no such parameter; a parameter its record leaves out, as an extension at its default or one
+        added later, has its default: ``params.interface_law`` "cusp"). Typed (:func:`stickslip.vocabulary.typed`), ``attrs["units"]``
         (``params.<name>``: None; :func:`stickslip.study` gives the plugins' units); ordered by kind, plugin,
         run id.
 
@@ -402,7 +493,7 @@ def runs(database=DEFAULT_DATABASE, **filters):
                + [f"r.{c}" for c in tail])
     statement = text(f"SELECT {', '.join(columns)} FROM runs AS r LEFT JOIN simulations AS s ON s.run_id = r.run_id"
                      f"{where} ORDER BY r.kind, r.plugin, r.run_id").bindparams(**bound)
-    return _units(typed(expand_json(_frame(database, statement), "params", prefix="params.")))
+    return _units(typed(expand_json(_defaults_filled(_frame(database, statement)), "params", prefix="params.")))
 
 
 def events(database=DEFAULT_DATABASE, **filters):
@@ -463,6 +554,14 @@ def figures(database=DEFAULT_DATABASE):
     return _units(_frame(database, statement))
 
 
+def _checked_query(query, database, time_limit, max_rows, memory_limit_mib):
+    """The bounds of :func:`sql` checked (:func:`check_bounds`), and the query not empty."""
+    bounds = check_bounds(time_limit, max_rows, memory_limit_mib)
+    if not isinstance(query, str) or not query.strip():
+        raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
+    return dict(zip(("time_limit", "max_rows", "memory_limit_mib"), bounds))
+
+
 def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS,
         memory_limit_mib=MEMORY_LIMIT_MIB):
     """Run one SQL query on a read-only connection and return the result.
@@ -482,14 +581,15 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     max_rows : int or None
         Refuse a result of more rows; None or 0: no limit.
     memory_limit_mib : float or None
-        Memory [MiB] of SQLite (heap, temporary tables and sorts included), and of the rows fetched
-        (the table built from them takes up to as much again); None or 0: no limit.
+        Memory [MiB] of SQLite (heap, temporary tables and sorts included), and of the result: the rows
+        fetched and the table made of them (16 bytes a value), counted as they come; None or 0: no limit.
 
     Returns
     -------
     pandas.DataFrame
-        Columns named as the vocabulary's in their dtype (:func:`stickslip.vocabulary.typed`: ``multi`` a
-        bool, ``started_at`` a datetime, ...); ``attrs["units"]`` gives their units (None for the others).
+        Columns named as the query names them, a name repeated made unique (``x``, ``x.1``: :func:`unique_names`),
+        those of the vocabulary in their dtype (:func:`stickslip.vocabulary.typed`: ``multi`` a bool,
+        ``started_at`` a datetime, ...); ``attrs["units"]`` gives their units (None for the others).
 
     Raises
     ------
@@ -503,8 +603,33 @@ def sql(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=M
     -----
     Cost: whatever the query costs, within the bounds; the indexes are listed in docs/database.md.
     """
-    time_limit, max_rows, memory_limit_mib = check_bounds(time_limit, max_rows, memory_limit_mib)
-    if not isinstance(query, str) or not query.strip():
-        raise QueryError(f"{database}: empty query; expected one SQL query (SELECT ...)")
-    return _units(_frame(database, text(query), only_reading=True, time_limit=time_limit, max_rows=max_rows,
-                         memory_limit_mib=memory_limit_mib))
+    bounds = _checked_query(query, database, time_limit, max_rows, memory_limit_mib)
+    return _units(_frame(database, text(query), only_reading=True, **bounds))
+
+
+@contextmanager
+def sql_pieces(query, database=DEFAULT_DATABASE, *, time_limit=TIME_LIMIT_S, max_rows=MAX_ROWS,
+               memory_limit_mib=MEMORY_LIMIT_MIB):
+    """Run one SQL query as :func:`sql` does, and stream its rows: the block reads them from the :class:`Pieces`.
+
+    What the block does with a piece (formats it, writes it) counts against the time limit; memory is bounded
+    for SQLite and for each piece, which is all that is held (``stickslip db sql --format csv|json``).
+
+    Parameters
+    ----------
+    query, database, time_limit, max_rows, memory_limit_mib
+        As :func:`sql`.
+
+    Yields
+    ------
+    Pieces
+        ``columns``, and lists of row tuples (values as SQLite gives them: int, float, str, bytes, None).
+
+    Raises
+    ------
+    QueryError
+        As :func:`sql`, also while the block reads (a bound reached after some rows were handed out).
+    """
+    bounds = _checked_query(query, database, time_limit, max_rows, memory_limit_mib)
+    with _pieces(database, text(query), only_reading=True, kept=False, **bounds) as pieces:
+        yield pieces

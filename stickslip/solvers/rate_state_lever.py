@@ -27,14 +27,14 @@ from ..experiment.timeseries import write_timeseries
 from ..experiment.virtual.rate_state_model import simulate, slab_order
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS
 from ..plugin_params import ParameterError, param, params_to_dict
-from .lever import LeverParams, check_protocol
+from .lever import LeverParams, check_memory, check_protocol, check_sampling
 
 __all__ = ["RateStateLeverParams", "run", "VERSION"]
 
 VERSION = "4"  # 4: coupling matrices in a fixed order (host-independent bits); 2: RODAS4 with relative slip-rate tolerances (issue 12); 3: the friction as state (issue 24)
 
 #: Parameters shared with the ``lever`` solver: apparatus, protocol, drive, sensors.
-SHARED = ("n", "protocol", "a", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",
+SHARED = ("n", "protocol", "driven_slab", "n_slabs", "seed", "duration", "gamma_start", "normal_force", "k_spring", "h", "H",
           "V", "force_rate", "force_noise", "frame_rate", "position_noise")
 #: Per-interface parameters: one value for every interface, or one per interface.
 PER_INTERFACE = ("rs_a", "rs_b", "D_c", "mu0")
@@ -48,42 +48,46 @@ def _shared_fields():
 
 _OWN = [
     ("rs_a", tuple[float, ...], param((0.013,), "rate-and-state direct effect a per interface (one value: all)",
-                                      exclusive_minimum=0)),
+                                      minimum=1e-6, maximum=1)),
     ("rs_b", tuple[float, ...], param((0.019, 0.017, 0.021, 0.018, 0.020),
-                                      "rate-and-state evolution effect b per interface (one value: all)", minimum=0)),
+                                      "rate-and-state evolution effect b per interface (one value: all)", minimum=0,
+                                      maximum=1)),
     ("D_c", tuple[float, ...], param((5e-4,), "memory length D_c per interface (one value: all)", unit="mm",
-                                     exclusive_minimum=0)),
+                                     minimum=1e-9, maximum=1e3)),
     ("mu0", tuple[float, ...], param((0.35,), "steady friction at V0 per interface (one value: all)",
-                                     exclusive_minimum=0)),
-    ("V0", float, param(1e-3, "reference slip rate V0", unit="mm/s", exclusive_minimum=0)),
+                                     minimum=1e-3, maximum=10)),
+    ("V0", float, param(1e-3, "reference slip rate V0", unit="mm/s", minimum=1e-12, maximum=1e6)),
     ("disorder", float, param(0.05, "relative standard deviation of b and D_c drawn per interface and seed "
-                                    "(quenched disorder; 0: none)", minimum=0)),
+                                    "(quenched disorder; 0: none)", minimum=0, maximum=1)),
     ("path_disorder", float, param(0.0, "relative standard deviation of mu0 along each interface's slip path "
                                          "(heterogeneity of the surface, drawn per interface and seed; 0: none)",
-                                   minimum=0)),
+                                   minimum=0, maximum=1)),
     ("path_correlation_length", float, param(0.025, "correlation length of mu0 along the slip path (the paper's "
                                                     "asperity size)", unit="mm", minimum=0.001, maximum=1.0)),
     ("slab_order", tuple[int, ...], param((), "physical slab at each position from the bottom, a permutation of "
                                                "1..n_slabs (empty: in order); each slab's interface parameters, "
                                                "quenched disorder and slip path travel with it (the paper's shuffled "
-                                               "control: 4,3,2,1,5)", minimum=1)),
-    ("slab_mass", float, param(0.143, "mass of one slab (PMMA 10 x 150 x 80 mm)", unit="kg", exclusive_minimum=0)),
-    ("load_mass", float, param(5.0, "dead weight on the top slab", unit="kg", minimum=0)),
+                                               "control: 4,3,2,1,5)", minimum=1, maximum=100)),
+    ("slab_mass", float, param(0.143, "mass of one slab (PMMA 10 x 150 x 80 mm)", unit="kg", minimum=1e-6,
+                                maximum=1e6)),
+    ("load_mass", float, param(5.0, "dead weight on the top slab", unit="kg", minimum=0, maximum=1e6)),
     ("theta_start", float, param(0.01, "contact age of every interface at t = 0 (just slipped)", unit="s",
-                                 exclusive_minimum=0)),
-    ("V_start", float, param(1e-6, "slip rate of every interface at t = 0", unit="mm/s", exclusive_minimum=0)),
+                                 minimum=1e-12, maximum=1e12)),
+    ("V_start", float, param(1e-6, "slip rate of every interface at t = 0", unit="mm/s", minimum=1e-15,
+                                 maximum=1e6)),
     ("slip_velocity", float, param(0.1, "slip rate above which the ground truth counts a slip", unit="mm/s",
-                                   exclusive_minimum=0)),
+                                   minimum=1e-9, maximum=1e6)),
     ("method", str, param(DEFAULT_METHOD, "implicit integrator (RODAS4: compiled Rosenbrock; others: scipy solve_ivp)",
                           choices=METHODS)),
     ("rtol", float, param(1e-5, "relative tolerance of the integrator (the absolute tolerances scale with it)",
-                          exclusive_minimum=0)),
+                          minimum=1e-12, maximum=0.1)),
 ]
 
 
 def _check(self):
-    """Check the protocol, the slab order and the per-interface lengths."""
+    """Check the protocol, the sampling, the slab order and the per-interface lengths."""
     check_protocol(self)
+    check_sampling(self)
     if self.slab_order and sorted(self.slab_order) != list(range(1, self.n_slabs + 1)):
         raise ParameterError(f"parameter 'slab_order': expected a permutation of 1..n_slabs={self.n_slabs} "
                              f"(or nothing), got {list(self.slab_order)}")
@@ -94,13 +98,15 @@ def _check(self):
 
 
 RateStateLeverParams = dataclasses.make_dataclass(
-    "RateStateLeverParams", _shared_fields() + _OWN, frozen=True, namespace={"check": _check})
+    "RateStateLeverParams", _shared_fields() + _OWN, frozen=True,
+    namespace={"check": _check, "RENAMED": LeverParams.RENAMED})
 RateStateLeverParams.__module__ = __name__
 RateStateLeverParams.__doc__ = ("Parameters of one rate-and-state virtual run: the lever's apparatus, protocol and "
                                 "sensors, and the interfaces' rate-and-state friction and inertia.")
 
 
 @registry.register("solver", "rate-state-lever", VERSION, RateStateLeverParams, produces="timeseries",
+                   preflight=check_memory,
                    summary="virtual lever experiment with inertial slabs on rate-and-state (aging law) interfaces")
 def run(params, output, *, threads, inputs):
     """Run one rate-and-state virtual experiment and write its time-series file with the ground truth."""

@@ -23,7 +23,7 @@ rule simulate:
     params:
         params=lambda wildcards: Study.dumps(STUDY.simulation(wildcards.solver, wildcards.run_id).params),
         inputs=lambda wildcards: Study.dumps(STUDY.solver_inputs(wildcards.solver, wildcards.run_id)),
-        code=lambda wildcards: Study.code("solver", wildcards.solver),
+        code=lambda wildcards: STUDY.simulation_code(wildcards.solver, wildcards.run_id),
         module=lambda wildcards: Study.module("solver", wildcards.solver),
     conda:
         CONDA_ENV
@@ -57,7 +57,7 @@ for BATCH in STUDY.batches:
             solver=BATCH.solver,
             params=[Study.dumps(sim.params) for sim in BATCH.runs],
             inputs=[Study.dumps(STUDY.solver_inputs(sim.solver, sim.run_id)) for sim in BATCH.runs],
-            code=Study.code("solver", BATCH.solver),
+            code=[STUDY.simulation_code(sim.solver, sim.run_id) for sim in BATCH.runs],
             module=Study.module("solver", BATCH.solver),
         conda:
             CONDA_ENV

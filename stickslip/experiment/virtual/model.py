@@ -25,7 +25,7 @@ def per_interface(params, name):
 
 def apparatus(params):
     """The :class:`~stickslip.experiment.virtual.Apparatus` of the parameters."""
-    return Apparatus.from_protocol(params.protocol, n=params.n, a=params.a, n_slabs=params.n_slabs,
+    return Apparatus.from_protocol(params.protocol, n=params.n, a=params.driven_slab, n_slabs=params.n_slabs,
                                    k_spring=params.k_spring, normal_force=params.normal_force, h=params.h,
                                    H=params.H, V=params.V, gamma_start=params.gamma_start)
 
@@ -90,7 +90,7 @@ def sensor_signals(params, lever, positions, rng):
     -------
     ExperimentRecord
     """
-    return record(lever, positions, params.duration, n=params.n, protocol=params.protocol, a=params.a,
+    return record(lever, positions, params.duration, n=params.n, protocol=params.protocol, a=params.driven_slab,
                   force_rate=params.force_rate, frame_rate=params.frame_rate, force_noise=params.force_noise,
                   position_noise=params.position_noise, rng=rng)
 

@@ -22,6 +22,27 @@ def sample_times(duration, rate):
     return np.arange(int(np.floor(duration * rate + 1e-9)) + 1) / rate
 
 
+def recording_bytes(duration, force_rate, frame_rate, n_slabs):
+    """Memory that :func:`record` takes at least for a run [B].
+
+    Every force sample takes its time and force and, while it is made, the slip and position of every slab; every
+    frame its time and the slip, position and noise of every slab (float64).
+
+    Parameters
+    ----------
+    duration : float
+        [s].
+    force_rate, frame_rate : float
+        [Hz].
+    n_slabs : int
+
+    Returns
+    -------
+    float
+    """
+    return 8.0 * (duration * force_rate * (2 * n_slabs + 2) + duration * frame_rate * (3 * n_slabs + 1))
+
+
 def _accumulated(times, starts, ends, amounts, ramp):
     """Sum of amounts reached at ``times`` by episodes that do not overlap.
 

@@ -36,6 +36,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ... import progress
+from ...errors import SolverError
 from ...fixed_order import dot, inverse
 from . import rosenbrock
 from .slab_equations import jacobian as _jacobian, rhs as _rhs, slip_rates as _slip_rates
@@ -292,7 +293,7 @@ class SlabDynamics:
         solution = solve_ivp(rhs, (0.0, duration), y0, method=method, rtol=rtol, atol=atol,
                              jac=lambda t, y: self.jacobian(y, rate))
         if not solution.success:
-            raise RuntimeError(f"rate-and-state integration failed at t = {solution.t[-1]:.6g} s: {solution.message}")
+            raise SolverError(f"rate-and-state integration failed at t = {solution.t[-1]:.6g} s: {solution.message}")
         clock.at(duration, solution.t.size - 1)
         y = solution.y.T
         return Trajectory(solution.t, y, np.array([self.rhs(row, rate) for row in y]))
@@ -309,8 +310,8 @@ class SlabDynamics:
             t_pause = duration * k / PROGRESS_PIECES
             t, y, dydt, ok, h = rosenbrock.integrate(y_now, t_now, h, t_pause, duration, args, rtol, atol, method)
             if not ok:
-                raise RuntimeError(f"rate-and-state integration failed at t = {t[-1]:.6g} s: step size underflow "
-                                   f"of {name}")
+                raise SolverError(f"rate-and-state integration failed at t = {t[-1]:.6g} s: step size underflow "
+                                  f"of {name}")
             ts.append(t[1:])            # every call starts where the previous one ended
             ys.append(y[1:])
             fs.append(dydt[1:])

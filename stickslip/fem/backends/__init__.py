@@ -6,42 +6,35 @@ and ``assembled`` (the reference), numba CPU backends (:mod:`.cpu`), and ``cuda`
 :mod:`.cuda`; optional dependency numba-cuda). A backend whose results are
 bit-identical to the default's would be an execution option like ``threads``; both alternatives
 here change the round-off, so the choice is the ``backend`` parameter of ``fem`` (recorded in the
-run file and its id). A new backend: one module and :func:`register_backend` (docs/developing.md,
-"A new backend").
+run file and its id). A new backend: a class decorated by :func:`register_backend`, in a module of this
+package (every module of it is imported) or of another package that names it in the entry-point group
+:data:`ENTRY_POINT_GROUP` (docs/developing.md, "A new backend"). A run's code hash covers the backend it
+chooses, not the others (:func:`stickslip.provenance.code.plugin_code_hash`).
 """
 
 import os
 from importlib.metadata import PackageNotFoundError, version
 
+from ...discovery import import_modules, load_entry_points
 from ...plugin_params import ParameterError
-from .base import CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend
-from .cpu import AssembledBackend, StructuredBackend
+from .base import BACKENDS, CONVERGED, FIELDS, MARGIN, MAX_ITER_REACHED, QUIET, Backend, register_backend
 from .cuda import CudaBackend
 
-__all__ = ["BACKENDS", "DEFAULT_BACKEND", "Backend", "make_backend", "register_backend", "FIELDS", "CONVERGED",
-           "MARGIN", "QUIET", "MAX_ITER_REACHED", "backend_arithmetic", "gpu_arithmetic", "SIMULATOR_VARIABLE"]
+__all__ = ["BACKENDS", "DEFAULT_BACKEND", "ENTRY_POINT_GROUP", "Backend", "make_backend", "register_backend", "FIELDS",
+           "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED", "backend_arithmetic", "gpu_arithmetic",
+           "SIMULATOR_VARIABLE"]
 
 #: Set to 1 to run the ``cuda`` backend on numba's CUDA simulator outside the tests (which may anyway).
 SIMULATOR_VARIABLE = "STICKSLIP_CUDA_SIMULATOR"
 
-#: Backend classes by name.
-BACKENDS = {}
+#: The entry-point group through which other packages add backends (a module registering them).
+ENTRY_POINT_GROUP = "stickslip.fem.backends"
 
 #: The backend of a run that names none.
 DEFAULT_BACKEND = "structured"
 
-
-def register_backend(cls):
-    """Register a backend class (class decorator); its ``name`` becomes a choice of the ``backend`` parameter."""
-    if cls.name in BACKENDS:
-        raise ValueError(f"backend {cls.name!r} is registered twice")
-    BACKENDS[cls.name] = cls
-    return cls
-
-
-register_backend(StructuredBackend)
-register_backend(AssembledBackend)
-register_backend(CudaBackend)
+import_modules(__name__)
+load_entry_points(ENTRY_POINT_GROUP)
 
 
 def _simulated():

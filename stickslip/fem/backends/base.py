@@ -2,13 +2,17 @@
 
 A backend is chosen per run (:func:`..backends.make_backend`) and prepared once for a model on its
 mesh (:meth:`Backend.prepare`); from then on it **owns the state** of the stack: displacement,
-velocity, acceleration, forces, the well of every interface Gauss point, the yield strains, the
+velocity, acceleration, forces, the well of every interface Gauss point, the yield strains (the model has none:
+the backend's copy is the only one, given by :meth:`Backend.set_yield_strains`), the
 drive targets and the time of its dynamics. The rest of the package reads and changes that state only through
 the methods below, each a point where a device backend synchronises with the host
 (FrictionQPotFEM's ``setU`` -> ``updated_u``): a change of displacement, drive or yield strains
 re-evaluates everything that follows from it before the call returns. The CPU backends hand out
 read-only views and change their arrays in place (nothing is copied); a device backend copies what
-:meth:`Backend.read` asks for and nothing else, and runs whole minimisations on the device.
+:meth:`Backend.read` asks for and nothing else, and runs whole minimisations on the device. What needs no
+array on the host stays where the state is: an exact copy of the state and the return to it
+(:meth:`Backend.checkpoint`, :meth:`Backend.rollback`), and whether a Gauss point changed well since such a
+copy (:meth:`Backend.wells_changed`, a number).
 
 State fields (:data:`FIELDS`): ``u``, ``v``, ``a`` float64 [ndof] (displacement [length],
 velocity, acceleration), ``f`` float64 [ndof] (internal force, material and drive [force]),
@@ -24,7 +28,13 @@ Statuses of :meth:`Backend.minimise`: :data:`CONVERGED`, :data:`MARGIN`, :data:`
 
 import abc
 
-__all__ = ["Backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED", "read_only"]
+import numpy as np
+
+__all__ = ["Backend", "BACKENDS", "register_backend", "FIELDS", "CONVERGED", "MARGIN", "QUIET", "MAX_ITER_REACHED",
+           "read_only", "unbounded_wells"]
+
+#: Backend classes by name (:func:`register_backend`): the choices of the ``backend`` parameter.
+BACKENDS = {}
 
 #: The state fields a backend holds (module docstring).
 FIELDS = ("u", "v", "a", "f", "idx", "eps", "sig", "target", "ubar", "lever", "t")
@@ -39,6 +49,14 @@ QUIET = 2
 MAX_ITER_REACHED = -1
 
 
+def register_backend(cls):
+    """Register a backend class (class decorator); its ``name`` becomes a choice of the ``backend`` parameter."""
+    if cls.name in BACKENDS:
+        raise ValueError(f"backend {cls.name!r} is registered twice")
+    BACKENDS[cls.name] = cls
+    return cls
+
+
 def read_only(array):
     """A view of ``array`` that cannot be written (what a CPU backend's :meth:`Backend.read` hands out)."""
     view = array.view()
@@ -46,10 +64,18 @@ def read_only(array):
     return view
 
 
+def unbounded_wells(ni):
+    """Yield strains of one unbounded well per Gauss point, ``[-inf, inf]``: float64 [ni, 2], for a model whose
+    interfaces are elastic (:class:`..laws.Elastic`; the linear response's)."""
+    return np.tile(np.array([[-np.inf, np.inf]]), (ni, 1))
+
+
 class Backend(abc.ABC):
     """How the numbers of the fem model are computed; after :meth:`prepare` it owns the state.
 
-    Class attributes: ``name`` (the value of the ``backend`` parameter), ``summary`` (one line).
+    Class attributes: ``name`` (the value of the ``backend`` parameter), ``summary`` (one line), and, for a
+    device backend that runs several runs together, ``run_ensemble(runs)`` (each ``run(backend)`` made with a
+    backend of the ensemble; returns what each returned; the ``fem`` solver's GPU batches).
     Attributes of a prepared backend: ``model`` (the :class:`..model.Model` it computes, read only)
     and ``threads``.
     """
@@ -63,27 +89,20 @@ class Backend(abc.ABC):
         return ""
 
     @abc.abstractmethod
-    def prepare(self, model, mesh):
+    def prepare(self, model, mesh, epsy):
         """A backend for ``model`` on ``mesh`` (a new object) owning a state at rest at the origin.
 
-        Parameters
-        ----------
-        model : stickslip.fem.model.Model
-        mesh : stickslip.mesh.LayeredMesh
-            The mesh the model was built from.
-
-        Returns
-        -------
-        Backend
-            ``u = v = a = 0``, drive targets 0, ``t = 0``, every Gauss point in the well of its
-            strain, forces evaluated.
+        ``model`` (:class:`..model.Model`) built from ``mesh`` (:class:`...mesh.LayeredMesh`); ``epsy`` the yield
+        strains it holds (as :meth:`set_yield_strains`'s; :func:`unbounded_wells` for elastic interfaces). The state:
+        ``u = v = a = 0``, drive targets 0, ``t = 0``, every Gauss point in the well of its strain, forces evaluated.
         """
 
     @abc.abstractmethod
-    def for_model(self, model):
-        """A prepared backend for another model on the same mesh and drive (another law or yield strains).
+    def for_model(self, model, epsy):
+        """A prepared backend for another model on the same mesh and drive (e.g. another law), holding ``epsy``.
 
-        It shares what depends on the mesh only and owns a state of its own, at rest at the origin.
+        It shares what depends on the mesh only and owns a state of its own, at rest at the origin (as
+        :meth:`prepare`'s).
         """
 
     @abc.abstractmethod
@@ -137,16 +156,37 @@ class Backend(abc.ABC):
 
         The window of held yield strains moved (the same wells, numbered from another start) or was
         widened, or restarted (``shift`` None); forces re-evaluated, every Gauss point moved to
-        the well of its strain.
+        the well of its strain. ``epsy`` is the backend's from now on: the caller never changes it.
         """
 
     @abc.abstractmethod
     def checkpoint(self):
-        """An exact copy of the whole state, kept by the backend (an opaque token for :meth:`rollback`)."""
+        """An exact copy of the whole state, the held yield strains included, kept where the state is (an opaque
+        token for :meth:`rollback` and :meth:`wells_changed`; nothing comes to the host)."""
 
     @abc.abstractmethod
     def rollback(self, token):
-        """Return to the state of :meth:`checkpoint` ``token``, bit for bit."""
+        """Return to the state of :meth:`checkpoint` ``token``, bit for bit (its yield strains too)."""
+
+    @abc.abstractmethod
+    def wells_changed(self, token, shift=None, elements=None):
+        """How many interface Gauss points are in another well than at :meth:`checkpoint` ``token`` (counted where the
+        state is: one number comes to the host).
+
+        Parameters
+        ----------
+        token
+            A checkpoint of this backend.
+        shift : numpy.ndarray, optional
+            int64 [ni]: how far the wells of block ``e`` were renumbered down since (:meth:`set_yield_strains`'s
+            ``shift``, summed): a Gauss point changed well if ``idx + shift`` differs from the checkpoint's.
+        elements : numpy.ndarray, optional
+            int64: count the Gauss points of these interface elements only (default: all).
+
+        Returns
+        -------
+        int
+        """
 
     @abc.abstractmethod
     def minimise(self, tol, niter_tol, max_iter, margin, record, quiet=0):

@@ -4,9 +4,14 @@ A law is an immutable value passed to the kernels (``model.law``), which call it
 generic functions of :mod:`.generic`, compiled for its type. Built in: :class:`.cusp.Cusp`
 (the paper's), :class:`.smooth.Smooth` (wells joined smoothly) and :class:`.elastic.Elastic` (no
 wells: the linear response). :mod:`.wells` finds the well a strain lies in. A new law: one module
-with its class decorated by :func:`.generic.register_law`, imported here (docs/developing.md).
+with its class decorated by :func:`.generic.register_law`, in this package (every module of it is
+imported) or in another package that names it in the entry-point group :data:`ENTRY_POINT_GROUP`
+(docs/writing-a-plugin.md). A run's code hash covers the law it chooses, not the others
+(:func:`stickslip.provenance.code.plugin_code_hash`: the imports of a law's module in this file, the
+re-exports below and the discovery, do not count).
 """
 
+from ...discovery import import_modules, load_entry_points
 from .cusp import Cusp
 from .elastic import Elastic
 from .generic import (INTERFACE_LAWS, LAWS, backward_barrier, deviatoric_factor, energy_density, forward_barrier,
@@ -14,9 +19,12 @@ from .generic import (INTERFACE_LAWS, LAWS, backward_barrier, deviatoric_factor,
 from .smooth import Smooth
 from .wells import well_index
 
-__all__ = ["LAWS", "INTERFACE_LAWS", "Cusp", "Smooth", "Elastic", "make_law", "register_law", "mirrored",
-           "deviatoric_factor", "well_energy", "forward_barrier", "backward_barrier", "well_stress", "energy_density",
-           "well_index", "extra_parameters"]
+__all__ = ["LAWS", "INTERFACE_LAWS", "ENTRY_POINT_GROUP", "Cusp", "Smooth", "Elastic", "make_law", "register_law",
+           "mirrored", "deviatoric_factor", "well_energy", "forward_barrier", "backward_barrier", "well_stress",
+           "energy_density", "well_index", "extra_parameters"]
+
+#: The entry-point group through which other packages add interface laws (a module registering them).
+ENTRY_POINT_GROUP = "stickslip.fem.laws"
 
 
 def extra_parameters(cls):
@@ -54,3 +62,7 @@ def make_law(name, K, G, extra=()):
     if names:
         law.check_parameters()
     return law
+
+
+import_modules(__name__)
+load_entry_points(ENTRY_POINT_GROUP)

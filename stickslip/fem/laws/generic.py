@@ -122,17 +122,29 @@ def register_law(cls):
         ``(law, eq, lo, hi)``; ``backward_barrier`` too if its wells are not symmetric), a method
         ``newton_moduli()`` (the moduli ``(K, G)`` of an elastic element whose stiffness bounds the
         law's curvature in every well from above, for the exact relaxation, :mod:`..equilibrium`),
-        and, if it has fields after ``K`` and ``G``, ``parameter_docs`` (name -> one line with the
-        unit) and ``check_parameters()`` (raises ValueError naming the field).
+        and, if it has fields after ``K`` and ``G``, a default for each of them (``namedtuple(...,
+        defaults=(...))``: a representative value, so that ``cls(K, G)`` is a law, as the package's
+        tests build every registered law), ``parameter_docs`` (name -> one line with the unit) and
+        ``check_parameters()`` (raises ValueError naming the field).
 
     Returns
     -------
     type
         ``cls``, now callable through the generic functions of this module and listed in :data:`LAWS`
         (and in :data:`INTERFACE_LAWS` if it ``yields``).
+
+    Raises
+    ------
+    ValueError
+        If a law of that name is registered already, or a field after ``K`` and ``G`` has no default.
     """
     if cls.name in LAWS:
         raise ValueError(f"interface law {cls.name!r} is registered twice")
+    missing = [name for name in cls._fields[2:] if name not in cls._field_defaults]
+    if missing:
+        raise ValueError(f"interface law {cls.name!r}: parameter(s) {', '.join(missing)} without a default; give "
+                         f"each field after K and G one: namedtuple({cls.__name__!r}, {cls._fields!r}, "
+                         "defaults=(...))")
     if "backward_barrier" not in vars(cls):
         cls.backward_barrier = staticmethod(njit(inline="always")(mirrored(cls.forward_barrier)))
     for name in _PROVIDED:

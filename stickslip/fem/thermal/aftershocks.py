@@ -41,17 +41,16 @@ def _stress(observer, a):
 def _unload_to(simulation, protocol, observer, a, stress):
     """Bring the load back along the linear response until interface ``a``'s stress is ``stress`` [sig0]."""
     s, stack = simulation, simulation.stack
-    start = stack.stored()
+    start = stack.checkpoint()
     now = _stress(observer, a)
     probe = -1.0
     s.loading.load(probe)
     slope = (_stress(observer, a) - now) / probe
-    stack.restore(*start)
+    stack.rollback(start)
     step = min((stress - now) / slope, 0.0) if slope > 0 else 0.0
-    token = stack.watch()
     s.loading.load(step)
-    if stack.moved(token):
-        stack.restore(*start)
+    if stack.changed_since(start):
+        stack.rollback(start)
         protocol.perturb_and_relax(_Unload(s.loading, step), s.params.margin)
         protocol.after_event(s.params.margin, 0)
 
@@ -63,7 +62,7 @@ def aftershock_trial(simulation, state, hold_time, replica, control=None, max_ev
     ----------
     simulation : stickslip.fem.simulation.Simulation
         Of a thermal run.
-    state : tuple
+    state : stickslip.formats.fem_run.StoredState
         A stored increment (:meth:`stickslip.formats.fem_run.RunFile.state`).
     hold_time : float
         Duration of the hold [time].
@@ -82,7 +81,7 @@ def aftershock_trial(simulation, state, hold_time, replica, control=None, max_ev
         ``max_events`` events).
     """
     s, p = simulation, simulation.params
-    s.stack.restore(*state)
+    s.stack.restore(state)
     observer = Observer(s)
     protocol = thermal_protocol(s.stack, s.model, s.loading, s.relaxation, p, s.mesh, s.constants,
                                 stream=STREAM + REPLICAS * (replica + 1))
@@ -95,13 +94,13 @@ def aftershock_trial(simulation, state, hold_time, replica, control=None, max_ev
     events, complete = [], False
     previous = observer.well_index()
     for k in range(1, max_events + 1):
-        protocol.step(False, p.margin, 2 * k - 1)
+        protocol.step(p.margin, 2 * k - 1)  # the load to the next event
         t = s.stack.time - t0
         if t >= hold_time:
             complete = True
             break
         previous = observer.well_index()
-        protocol.step(True, p.margin, 2 * k)
+        protocol.step(p.margin, 2 * k)  # that event
         event = observer.observe(previous)
         previous = observer.well_index()
         events.append([t, *(event[f"A_a{a}"] for a in interfaces)])

@@ -53,9 +53,9 @@ class JunctionChange:
 
     def moves(self):
         """:meth:`apply`, and whether a Gauss point changed well (its stress changed: the stack must relax)."""
-        token = self.stack.watch()
+        token = self.stack.checkpoint()
         self.apply()
-        return self.stack.moved(token)
+        return self.stack.changed_since(token) > 0
 
 
 def stack_junctions(stack, blocks, params):
@@ -116,7 +116,7 @@ class AgingProtocol(ThermalProtocol):
         self.header = {**self.header, "junction_strengthening": p.junction_strengthening,
                        "junction_glass_temperature": p.junction_glass_temperature,
                        "junction_attempt_rate": p.junction_attempt_rate}
-        self.state_fields = {name: ((model.epsy.shape[0],), dtype) for name, dtype in STATE_FIELDS.items()}
+        self.state_fields = {name: ((model.iface_dofs.shape[0],), dtype) for name, dtype in STATE_FIELDS.items()}
         if table is None:
             self.renew(p.margin, 0)  # the junctions of a new state (a restored one keeps its own)
         else:
@@ -166,7 +166,7 @@ def thermal_protocol(stack, model, loading, relaxation, params, mesh, constants,
     p = params
     beta = 1.0 / (p.temperature * energy_unit(p, constants["h"]))
     if p.junction_strengthening > 0.0:
-        junctions = stack_junctions(stack, model.epsy.shape[0], p)
+        junctions = stack_junctions(stack, model.iface_dofs.shape[0], p)
         source = ArrheniusWithRedraws(stack, model, loading, beta, p.attempt_rate, junctions, p.temperature)
         return AgingProtocol(stack, model, loading, relaxation, p, mesh, constants, source, table, stream)
     source = ArrheniusHops(stack, model, loading, beta, p.attempt_rate)

@@ -41,7 +41,7 @@ REPLICAS = 2**40
 def _barriers(simulation, unit):
     model, stack = simulation.model, simulation.stack
     idx, eps = stack.read("idx", "eps")
-    out = np.empty((model.epsy.shape[0], 2))
+    out = np.empty((model.iface_dofs.shape[0], 2))
     block_barriers(model.law, stack.yield_strains, idx, eps, simulation.loading.response.delta_eps, model.iface_dV, 0.0,
                    out)
     return out[:, FORWARD] / unit
@@ -71,8 +71,8 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
     ----------
     simulation : stickslip.fem.simulation.Simulation
         Of a thermal run.
-    state : tuple
-        ``(u, target, lever_target, t)`` of a stored increment (:meth:`stickslip.formats.fem_run.RunFile.state`).
+    state : stickslip.formats.fem_run.StoredState
+        A stored increment (:meth:`stickslip.formats.fem_run.RunFile.state`).
     hold_time : float
         Duration of the hold [time].
     below : float
@@ -99,7 +99,7 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
         :func:`_junctions` (NaN without aging), of every slip of an interface in order).
     """
     s, p = simulation, simulation.params
-    s.stack.restore(*state)
+    s.stack.restore(state)
     scale = drive_scale(s.loading.response, p.eps0, s.mesh)
     ds_c = s.loading.step_size(False)
     if ds_c >= below / scale:
@@ -127,12 +127,12 @@ def hold_trial(simulation, state, hold_time, below, replica, each=0):
     result = {"t0": t0, "held_below": held_below, "peak": np.nan, "interface": 0, "mu_start": np.nan, "failed_in_hold": False,
               "t_slip": np.nan, "hold_hops": 0}
     for k in range(1, MAX_EVENTS + 1):
-        protocol.step(False, p.margin, 2 * k - 1)
+        protocol.step(p.margin, 2 * k - 1)  # the load to the next event
         load = observer.observe(previous)
         t = s.stack.time - t0
         previous = load_wells = observer.well_index()
         at_peak = [_junctions(s.stack, a, p.N) for a in interfaces]
-        protocol.step(True, p.margin, 2 * k)
+        protocol.step(p.margin, 2 * k)  # that event
         event = observer.observe(previous)
         previous = observer.well_index()
         if t < hold_time:

@@ -7,8 +7,10 @@ upper nodes moved by ``+s/2`` in x, its lower nodes by ``-s/2``; a uniform simpl
 of its four Gauss points a strain ``deps / 2`` past the edge (the athermal kick's overshoot). The
 thermal protocol then relaxes the stack as after a kick
 (:meth:`..protocol.EventLoop.perturb_and_relax`: the relaxation of the run, an avalanche may
-follow), and restores the state before the hop if every well index came back (the block fell back
-into its well: the true barrier of the move is higher than the constant-load one).
+follow), and rolls back to the state before the hop if every well index came back (the block fell back
+into its well: the true barrier of the move is higher than the constant-load one). The amplitude is found on
+the host from the block's strain at the event (one read of the interface strains; its wells are those the draw
+saw, :class:`..host_copies.HostCopies`); whether the shear carried the block over is counted where the state is.
 """
 
 import math
@@ -117,22 +119,24 @@ class ShearHop:
         :data:`.barriers.FORWARD` or backward.
     overshoot : float
         Strain beyond the edge that every Gauss point of the block reaches (the kick's ``deps / 2``).
+    start : stickslip.fem.stack.Checkpoint
+        A checkpoint of the stack as it is (whenever :meth:`apply` is called, the stack is at it).
+
+    Attributes
+    ----------
+    amplitude : float
+        ``s`` of the shear mode from the state at ``start`` [length] (:func:`hop_step`; NaN: impossible).
     """
 
-    def __init__(self, stack, model, modes, block, direction, overshoot):
+    def __init__(self, stack, model, modes, block, direction, overshoot, start):
         self.stack = stack
         self.model = model
         self.mode = modes[block]
         self.block = block
-        self.direction = direction
-        self.overshoot = overshoot
-
-    def step(self):
-        """Amplitude ``s`` of the shear mode from the state now [length] (:func:`hop_step`; NaN: impossible)."""
-        b = self.block
-        eps, idx = self.stack.read("eps", "idx")
-        return hop_step(self.model.iface_dNdx[b], self.mode, eps[b], self.stack.yield_strains[b], idx[b], self.direction,
-                        self.overshoot)
+        self.start = start
+        eps, idx = stack.read("eps", "idx")
+        self.amplitude = hop_step(model.iface_dNdx[block], self.mode, eps[block], stack.yield_strains[block],
+                                  idx[block], direction, overshoot)
 
     def apply(self):
         """Shear the block over its edge.
@@ -140,13 +144,10 @@ class ShearHop:
         Raises
         ------
         SolverError
-            If the shear did not move every Gauss point of the block to the next well (a bug, not physics).
+            If the shear did not move every Gauss point of the block to another well (a bug, not physics).
         """
-        stack, b = self.stack, self.block
-        step = self.step()
-        start = stack.well_index()[b]
-        stack.add_u(self.model.iface_dofs[b], step * self.mode)
-        sign = 1 if self.direction == FORWARD else -1
-        if np.any(np.sign(stack.well_index()[b] - start) != sign):
-            raise SolverError(f"hop of block {b}: the kick of {step:.6e} did not carry all its Gauss points "
+        b = self.block
+        self.stack.add_u(self.model.iface_dofs[b], self.amplitude * self.mode)
+        if self.stack.changed_since(self.start, elements=np.array([b])) != 4:
+            raise SolverError(f"hop of block {b}: the kick of {self.amplitude:.6e} did not carry all its Gauss points "
                               "over the edge")

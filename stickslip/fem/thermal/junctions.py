@@ -25,48 +25,18 @@ backend its yield strains. The state (the well of every junction, as a global
 index, and its depth) is stored with every increment (``junction_well``, ``junction_depth``).
 """
 
-import math
-
 import numpy as np
 
 from ...numba_options import njit
 from .sampler import exponential
 
-__all__ = ["Junctions", "CAP", "STATE_FIELDS", "widening", "widen", "renew", "expected_redraws"]
+__all__ = ["Junctions", "CAP", "STATE_FIELDS", "widening", "widen", "renew"]
 
 #: Largest widening, as a fraction of the width of the neighbouring well it eats into.
 CAP = 0.5
 
 #: The per-increment state datasets of a run with junctions: name -> dtype (one value per block).
 STATE_FIELDS = {"junction_depth": np.float64, "junction_well": np.int64}
-
-
-def expected_redraws(attempt_rate, temperature, glass_temperature, duration):
-    """How often a junction at rest is redrawn in ``duration`` from a fresh one: the trap model's order of magnitude.
-
-    Below the glass temperature the waiting times of the redraws have a power-law tail of index
-    ``x = T / T_g < 1`` (the deeper the junction, the longer it lasts), so the redraws grow as ``(nu_j t)^x``;
-    at and above it as ``nu_j t``. Used to refuse parameters whose runs would not end
-    (:mod:`stickslip.fem.parameters`) and to bound the sampling (:func:`.redraws.sample_with_redraws`).
-
-    Parameters
-    ----------
-    attempt_rate : float
-        ``nu_j`` [1/time].
-    temperature, glass_temperature : float
-        ``T``, ``T_g`` [G eps0^2 h^2].
-    duration : float
-        [time] (``inf``: none).
-
-    Returns
-    -------
-    float
-        ``max(1, (nu_j duration)^min(1, T / T_g))`` (``inf`` for an infinite duration).
-    """
-    attempts = attempt_rate * duration
-    if not attempts > 1.0:
-        return 1.0
-    return math.inf if math.isinf(attempts) else attempts ** min(1.0, temperature / glass_temperature)
 
 
 @njit

@@ -12,9 +12,12 @@ Increments alternate as in the athermal protocol, a load then an event:
 - **event** (even increments, :meth:`ThermalProtocol.perform`): the hop (:meth:`ThermalProtocol.hop`)
   or the athermal kick (:meth:`..protocol.EventLoop.kick`), with the relaxation of the run.
 
-A hop whose block falls back into its well restores the state, counts as failed (column
+A hop whose block falls back into its well is undone, counts as failed (column
 ``failed_hops`` of the next load increment) and leaves that block and direction out of the
-rates until the next event; the draw goes on from the time of the failed hop. Avalanches take no
+rates until the next event; the draw goes on from the time of the failed hop. A hop goes to the host and back
+once: its block's strain at the event (a read of the interface strains); the state before it, the state after
+its avalanche and the return to either are checkpoints where the state is (:meth:`..stack.Stack.checkpoint`),
+and whether it fell back is counted there (:meth:`..stack.Stack.changed_since`). Avalanches take no
 time: the protocol keeps the physical time (its :class:`..clock.Clock`, registered with the stack; the
 minimisation's time steps are not added), which assumes that the drive moves the state by much less
 than a well during an avalanche.
@@ -87,15 +90,16 @@ class Pending(NamedTuple):
         The hop's direction, +1 forward, -1 backward; 0 otherwise.
     depth : float
         A redraw's new junction depth [G eps0^2 h^2]; NaN otherwise.
-    after : tuple or None
-        A hop's stored state after its avalanche (None: redo the hop, a run resumed at its load increment).
+    after : stickslip.fem.stack.Checkpoint or None
+        A checkpoint of the state after the hop's avalanche, its windows not yet moved ahead (None: redo the hop, a
+        run resumed at its load increment).
     """
 
     kind: int
     block: int = -1
     sign: int = 0
     depth: float = math.nan
-    after: tuple = None
+    after: object = None
 
 
 class ThermalProtocol(EventLoop):
@@ -131,7 +135,7 @@ class ThermalProtocol(EventLoop):
 
     def __init__(self, stack, model, loading, relaxation, params, mesh, constants, source, table=None,
                  stream=STREAM):
-        super().__init__(stack, loading, relaxation)
+        super().__init__(stack, loading, relaxation, table)
         p = params
         self.model, self.params, self.source = model, p, source
         self.clock = stack.clock
@@ -149,7 +153,7 @@ class ThermalProtocol(EventLoop):
         self.schedule = HoldSchedule(p.hold_times, p.hold_delay / p.drive_rate)
         if table is not None:
             replay_slips(table, p.N, self.schedule)
-            if not np.asarray(table["kick"])[-1]:  # resumed at a load increment: its event is next
+            if self.event_next:  # resumed at a load increment: its event is next
                 block, sign = int(np.asarray(table["hop_block"])[-1]), int(np.asarray(table["hop_direction"])[-1])
                 self.pending = Pending(THRESHOLD) if block < 0 else Pending(HOP, block, sign)
 
@@ -169,7 +173,7 @@ class ThermalProtocol(EventLoop):
         of the draw with its direction until the next event, and the draw goes on from its time.
         """
         stream = self._stream(increment)
-        allowed = np.ones((self.model.epsy.shape[0], 2), dtype=bool)
+        allowed = np.ones((self.model.iface_dofs.shape[0], 2), dtype=bool)
         held, failed = 0.0, 0
         self.source.begin()
         while True:
@@ -186,18 +190,18 @@ class ThermalProtocol(EventLoop):
             if draw.kind != HOP:
                 self.pending = Pending(draw.kind, draw.block, depth=draw.depth)
                 return row
-            loaded = self.stack.stored()
-            if self.hop(draw.block, draw.direction, margin):
+            loaded = self.stack.checkpoint()
+            if self.hop(draw.block, draw.direction, margin, loaded):
                 sign = 1 if draw.direction == FORWARD else -1
-                self.pending = Pending(HOP, draw.block, sign, after=self.stack.stored())
-                self.stack.restore(*loaded)
+                self.pending = Pending(HOP, draw.block, sign, after=self.stack.checkpoint())
+                self.stack.rollback(loaded)
                 return {**row, "hop_block": draw.block, "hop_direction": sign}
             failed += 1
             allowed[draw.block, draw.direction] = False
             self.source.undo(loaded)
 
-    def hop(self, block, direction, margin):
-        """Carry ``block`` over its edge in ``direction`` and relax; restore the state if it falls back.
+    def hop(self, block, direction, margin, loaded):
+        """Carry ``block`` over its edge in ``direction`` and relax (the windows not yet moved ahead).
 
         Parameters
         ----------
@@ -207,24 +211,20 @@ class ThermalProtocol(EventLoop):
             :data:`.barriers.FORWARD` or backward.
         margin : int
             See :meth:`..relaxation.DynamicRelaxation.relax`.
+        loaded : stickslip.fem.stack.Checkpoint
+            A checkpoint of the stack as it is, loaded to the hop.
 
         Returns
         -------
         bool
             True if some well index changed (the hop happened); False if the block fell back or its
-            shear mode cannot carry it over (the state is then as before).
+            shear mode cannot carry it over: the caller then rolls the stack back.
         """
-        stack = self.stack
-        shear = ShearHop(stack, self.model, self.modes, block, direction, self.overshoot)
-        if math.isnan(shear.step()):
+        shear = ShearHop(self.stack, self.model, self.modes, block, direction, self.overshoot, loaded)
+        if math.isnan(shear.amplitude):
             return False
-        before = stack.stored()
-        token = stack.watch()
-        self.perturb_and_relax(shear, margin)
-        if not stack.moved(token):
-            stack.restore(*before)
-            return False
-        return True
+        self.perturb_and_relax(shear, margin, before=loaded, ahead=False)
+        return self.stack.changed_since(loaded) > 0
 
     def perform(self, pending, margin):
         """The event ``pending`` (:class:`Pending`): the athermal kick, or the hop (its state after the avalanche,
@@ -233,12 +233,13 @@ class ThermalProtocol(EventLoop):
         if pending.kind == THRESHOLD:
             yield_element = self.kick(margin)[1]
         else:
-            after = pending.after
-            if after is None:
-                if not self.hop(pending.block, FORWARD if pending.sign > 0 else BACKWARD, margin):
-                    raise SolverError(f"the stored hop of block {pending.block} fell back when redone")
-                after = self.stack.stored()
-            self.stack.restore(*after)  # at rest: as the stored state (no velocity left from the avalanche)
+            if pending.after is not None:
+                self.stack.rollback(pending.after)
+            elif not self.hop(pending.block, FORWARD if pending.sign > 0 else BACKWARD, margin,
+                              self.stack.checkpoint()):
+                raise SolverError(f"the stored hop of block {pending.block} fell back when redone")
+            if self.stack.extend:
+                self.stack.hold_wells_ahead()  # what the hop's relaxation left for later
         return {"yield_element": yield_element, "hop_block": pending.block, "hop_direction": pending.sign,
                 "failed_hops": 0, "held": 0.0}
 

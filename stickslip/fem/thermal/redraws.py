@@ -23,7 +23,7 @@ Bounded, and stoppable: the compiled loop (:func:`redraw_loop`) applies at most 
 redraws per call and returns to Python (:data:`PAUSED`), where Ctrl-C and SIGTERM are handled, then
 :func:`sample_with_redraws` calls it again from where it paused: the same draws, bit for bit, as one
 call. The redraws before one event are bounded by :func:`redraw_bound` (:data:`REDRAW_MARGIN` times what
-the trap model expects, :func:`.junctions.expected_redraws`): beyond it the sampling stops with an error
+the trap model expects, :func:`..trap_model.expected_redraws`): beyond it the sampling stops with an error
 naming the parameters instead of running for ever (parameters that would need that many are refused
 before the run, :mod:`..parameters`).
 """
@@ -34,7 +34,8 @@ import numpy as np
 
 from ...numba_options import njit
 from ..errors import SolverError
-from .junctions import expected_redraws, widening
+from ..trap_model import expected_redraws
+from .junctions import widening
 from .sampler import HOP, NONE, STALLED, THRESHOLD, draw_event, exponential, stalled_error, uniform
 
 __all__ = ["REDRAW", "PAUSED", "REDRAWS_PER_CALL", "REDRAW_MARGIN", "REDRAW_FLOOR", "block_threshold",
@@ -199,7 +200,7 @@ def redraw_bound(blocks, attempt_rate, temperature, glass_temperature, duration)
     blocks : int
         Interface blocks.
     attempt_rate, temperature, glass_temperature, duration
-        As :func:`.junctions.expected_redraws` (``n``); ``duration`` the time to the athermal threshold or
+        As :func:`..trap_model.expected_redraws` (``n``); ``duration`` the time to the athermal threshold or
         the end of the stretch [time].
 
     Returns

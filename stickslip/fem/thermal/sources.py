@@ -3,7 +3,11 @@
 The thermal protocol (:class:`.protocol.ThermalProtocol`) asks its source, stretch by stretch of the
 hold schedule, for the next event after the time now (:meth:`ArrheniusHops.draw`), then to bring the
 stack to the drive offset of that event (:meth:`ArrheniusHops.settle`), and after a hop that fell back,
-to undo it (:meth:`ArrheniusHops.undo`). Two sources, composed into the protocol rather than inherited:
+to undo it (:meth:`ArrheniusHops.undo`: a rollback to a checkpoint, :meth:`..stack.Stack.rollback`). A draw reads
+the wells and strains of the interfaces (what the kinetic Monte Carlo needs to choose); a state returned to is
+not read again (:class:`..host_copies.HostCopies`), and the load to an event keeps every Gauss point in its well
+(counted where the state is, :func:`load_keeping_wells`), so the wells of the draw are those of the event. Two
+sources, composed into the protocol rather than inherited:
 
 - :class:`ArrheniusHops`: the blocks hop over their barriers at Arrhenius rates while the drive
   advances, or the athermal threshold comes first (:func:`.sampler.sample_event`). The offsets are
@@ -23,7 +27,33 @@ from ..errors import SolverError
 from .redraws import REDRAW, sample_with_redraws
 from .sampler import NONE, THRESHOLD, sample_event
 
-__all__ = ["Draw", "ArrheniusHops", "ArrheniusWithRedraws"]
+__all__ = ["Draw", "ArrheniusHops", "ArrheniusWithRedraws", "load_keeping_wells"]
+
+
+def load_keeping_wells(stack, loading, offset, since, redraws=0):
+    """Load ``stack`` by ``offset`` (a draw's drive offset), which keeps every Gauss point in its well.
+
+    Parameters
+    ----------
+    stack : stickslip.fem.stack.Stack
+    loading : stickslip.fem.loading.Loading
+    offset : float
+        [response units].
+    since : stickslip.fem.stack.Checkpoint
+        The state whose wells the stack must keep (the draw's).
+    redraws : int, optional
+        Junctions redrawn since (for the message).
+
+    Raises
+    ------
+    SolverError
+        If a Gauss point left its well on the way (round-off at a yield strain).
+    """
+    if offset != 0.0:
+        loading.load(offset)
+    if stack.changed_since(since):
+        raise SolverError(f"the load to the next event (drive offset {offset:.6e}, {redraws} junctions redrawn "
+                          "meanwhile) moved a Gauss point out of its well (round-off at a yield strain)")
 
 
 class Draw(NamedTuple):
@@ -82,8 +112,8 @@ class ArrheniusHops:
         self.offset = self.threshold = 0.0
 
     def begin(self):
-        """Start a load increment from the state now (kept until the event)."""
-        self.start = self.stack.stored()
+        """Start a load increment from the state now (a checkpoint: the stack stays there until the event)."""
+        self.start = self.stack.checkpoint()
         self.threshold = self.loading.step_size(False)
         self.offset = 0.0
 
@@ -110,7 +140,7 @@ class ArrheniusHops:
         Draw
         """
         m = self.model
-        idx, eps = self.stack.read("idx", "eps")  # a failed hop may have moved the held wells: read them anew
+        idx, eps = self.stack.read("idx", "eps")  # the start's, read once (a failed hop rolls back to it)
         kind, block, direction, dt = sample_event(
             m.law, self.stack.yield_strains, idx, eps, self.loading.response.delta_eps, m.iface_dV, allowed,
             self.beta, self.attempt_rate, self.offset, speed, until - t, self.threshold, *stream)
@@ -119,17 +149,17 @@ class ArrheniusHops:
         return Draw(kind, block, direction, dt, until if kind == NONE else t + dt, self.offset)
 
     def settle(self, draw):
-        """Bring the stack to the event: to the brink for the threshold, along the drive to a hop's offset."""
+        """Bring the stack to the event: to the brink for the threshold, along the drive to a hop's offset
+        (:func:`load_keeping_wells`)."""
         if draw.kind == THRESHOLD:
             self.loading.step(False)
         elif draw.kind != NONE:
-            self.loading.load(draw.offset)
+            load_keeping_wells(self.stack, self.loading, draw.offset, self.start)
 
     def undo(self, loaded):
-        """A hop fell back: the stack back to the increment's start, at the time of ``loaded`` (the state stored
-        before the hop)."""
-        u, target, lever_target, _ = self.start
-        self.stack.restore(u, target, lever_target, loaded[3])
+        """A hop fell back: the stack back to the increment's start (the clock goes on from the hop's time;
+        ``loaded``, the checkpoint at the hop, is not needed)."""
+        self.stack.rollback(self.start)
 
 
 class ArrheniusWithRedraws:
@@ -190,18 +220,13 @@ class ArrheniusWithRedraws:
         SolverError
             If a Gauss point left its well on the way (round-off at a yield strain).
         """
-        offset, redraws = draw.offset, draw.redraws
-        token = self.stack.watch()
-        if redraws:
+        token = self.stack.checkpoint()
+        if draw.redraws:
             self.stack.push_yield_strains()
-        if offset != 0.0:
-            self.loading.load(offset)
-        if self.stack.moved(token):
-            raise SolverError(f"the load to the next event (drive offset {offset:.6e}, {redraws} junctions redrawn "
-                              "meanwhile) moved a Gauss point out of its well (round-off at a yield strain)")
+        load_keeping_wells(self.stack, self.loading, draw.offset, token, draw.redraws)
         if draw.kind == THRESHOLD:
             self.loading.step(False)
 
     def undo(self, loaded):
-        """A hop fell back: the stack back to ``loaded``, the state stored before the hop."""
-        self.stack.restore(*loaded)
+        """A hop fell back: the stack back to ``loaded``, the checkpoint at the hop."""
+        self.stack.rollback(loaded)

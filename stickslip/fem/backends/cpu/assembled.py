@@ -12,6 +12,7 @@ from numba import prange
 
 from ....numba_options import njit
 from .plates import register_plate_operator
+from ..base import register_backend
 from .backend import CpuBackend
 
 __all__ = ["AssembledBackend", "CsrPlates"]
@@ -53,6 +54,7 @@ class CsrPlates(namedtuple("CsrPlates", [
     product = staticmethod(_product)
 
 
+@register_backend
 class AssembledBackend(CpuBackend):
     """Numba CPU kernels with the assembled CSR product of the plates (the reference)."""
 

@@ -19,7 +19,7 @@ from .dynamics import residual, time_steps
 from .forces import compute_force, wells_hold
 from .interface_elements import NIN, NOUT, interface_layout
 from .minimise import minimise
-from .state import State, new_state
+from .state import new_state
 
 __all__ = ["CpuBackend", "CpuWork", "InterfaceWork", "parallel_blocks"]
 
@@ -76,7 +76,7 @@ class CpuBackend(Backend):
         """The plate operator of a model on its mesh (a registered named tuple, :mod:`.plates`)."""
         raise NotImplementedError
 
-    def prepare(self, model, mesh):
+    def prepare(self, model, mesh, epsy):
         nblock = parallel_blocks(self.threads)
         grad, volume = interface_layout(model.iface_dNdx, model.iface_dV)
         ni = model.iface_dofs.shape[0]
@@ -84,12 +84,12 @@ class CpuBackend(Backend):
                               fe=np.zeros((ni, 8)))
         prepared = copy.copy(self)
         prepared.work = CpuWork(nblock=nblock, plates=self.plate_operator(model, mesh, nblock), iface=iface)
-        return prepared.for_model(model)
+        return prepared.for_model(model, epsy)
 
-    def for_model(self, model):
+    def for_model(self, model, epsy):
         other = copy.copy(self)
         other.model = model
-        other.state = new_state(model)
+        other.state = new_state(model, np.ascontiguousarray(epsy, dtype=np.float64))
         other._direction = None
         other._evaluate(True)
         return other
@@ -138,17 +138,27 @@ class CpuBackend(Backend):
         self._evaluate(False)
 
     def set_yield_strains(self, epsy, shift=None):
-        self.model = self.model._replace(epsy=epsy)
+        # kept, not copied: whoever gives yield strains gives a new array for new values (the window does)
+        self.state = self.state._replace(epsy=np.ascontiguousarray(epsy, dtype=np.float64))
         if shift is not None:
             self.state.idx[...] -= np.asarray(shift, dtype=np.int64)[:, None]
         self._evaluate(True)
 
     def checkpoint(self):
-        return State(*(np.array(value, copy=True) for value in self.state))
+        # the yield strains are never changed in place: the checkpoint keeps the array itself
+        return self.state._replace(**{name: value.copy() for name, value in self.state._asdict().items()
+                                      if name != "epsy"})
 
     def rollback(self, token):
-        for mine, kept in zip(self.state, token):
-            mine[...] = kept
+        for name, kept in token._asdict().items():
+            if name != "epsy":
+                getattr(self.state, name)[...] = kept
+        self.state = self.state._replace(epsy=token.epsy)
+
+    def wells_changed(self, token, shift=None, elements=None):
+        rows = slice(None) if elements is None else np.asarray(elements, dtype=np.int64)
+        now = self.state.idx[rows] if shift is None else self.state.idx[rows] + np.asarray(shift)[rows, None]
+        return int(np.count_nonzero(now != token.idx[rows]))
 
     def minimise(self, tol, niter_tol, max_iter, margin, record, quiet=0):
         return minimise(self.model, self.work, self.state, tol, niter_tol, max_iter, margin, record, quiet)

@@ -85,10 +85,10 @@ def interface_forces(model, work, state, update_wells):
     """
     m, w = model, work.iface
     if work.nblock > 1:
-        _interface_force_parallel(work.nblock, m.law, m.iface_dofs, w.grad, w.volume, m.epsy, state.u, state.idx,
+        _interface_force_parallel(work.nblock, m.law, m.iface_dofs, w.grad, w.volume, state.epsy, state.u, state.idx,
                                   w.inp, w.out, update_wells)
     else:
-        interface_force(0, m.iface_dofs.shape[0], m.law, m.iface_dofs, w.grad, w.volume, m.epsy, state.u, state.idx,
+        interface_force(0, m.iface_dofs.shape[0], m.law, m.iface_dofs, w.grad, w.volume, state.epsy, state.u, state.idx,
                         w.inp, w.out, update_wells)
     out, fe = w.out, w.fe
     for e in range(m.iface_dofs.shape[0]):
@@ -133,6 +133,6 @@ def wells_hold(model, state):
         for q in range(4):
             i = state.idx[e, q]
             x = equivalent_strain(state.eps[e, q, 0], state.eps[e, q, 1], state.eps[e, q, 2])
-            if well_index(model.epsy[e], x, i) != i:
+            if well_index(state.epsy[e], x, i) != i:
                 return False
     return True

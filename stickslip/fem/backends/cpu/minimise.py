@@ -50,9 +50,9 @@ Carry = namedtuple("Carry", [
 
 
 @njit
-def within_margin(model, idx, margin):
-    """True if every interface Gauss point is more than ``margin`` wells from the end of its sequence."""
-    limit = model.epsy.shape[1] - margin
+def within_margin(epsy, idx, margin):
+    """True if every interface Gauss point is more than ``margin`` wells from the end of its held yield strains ``epsy``."""
+    limit = epsy.shape[1] - margin
     for e in range(idx.shape[0]):
         for q in range(4):
             if idx[e, q] >= limit:
@@ -171,7 +171,7 @@ def minimise_steps(model, work, state, tol, niter_tol, max_iter, margin, record,
             state.v[:] = 0.0
             state.a[:] = 0.0
             return CONVERGED, events
-        if margin > 0 and not within_margin(model, state.idx, margin):
+        if margin > 0 and not within_margin(state.epsy, state.idx, margin):
             return MARGIN, events
         if quiet > 0:
             unchanged += 1

@@ -12,6 +12,7 @@ from numba import prange
 from ....numba_options import njit
 from .plates import register_plate_operator
 from .stencils import apply_groups, build_stencils, gather_views, plan_blocks, plan_product, plate_product
+from ..base import register_backend
 from .backend import CpuBackend
 
 __all__ = ["StructuredBackend", "StencilPlates"]
@@ -54,6 +55,7 @@ class StencilPlates(namedtuple("StencilPlates", [
     product = staticmethod(_product)
 
 
+@register_backend
 class StructuredBackend(CpuBackend):
     """Numba CPU kernels with the plates' stencil product (6x the CSR product at N = 1458)."""
 

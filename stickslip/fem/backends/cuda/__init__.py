@@ -22,10 +22,11 @@ simulator (tests, tiny meshes).
 
 import importlib.util
 import threading
+from typing import NamedTuple
 
 import numpy as np
 
-from ..base import Backend
+from ..base import Backend, register_backend
 
 __all__ = ["CudaBackend", "run_ensemble"]
 
@@ -48,6 +49,14 @@ def _why_not():
     return f"{reason}; run on a machine with an NVIDIA GPU or choose a CPU backend (structured, assembled)"
 
 
+class Checkpoint(NamedTuple):
+    """A checkpoint of a ``cuda`` run: device copies of its slot's state and the yield strains it held."""
+
+    device: dict
+    epsy: object
+
+
+@register_backend
 class CudaBackend(Backend):
     """The fem model on an NVIDIA GPU (module docstring).
 
@@ -61,43 +70,56 @@ class CudaBackend(Backend):
     groups : int, optional
         Blocks a realisation is spread over in a minimisation at most (default: as many as its tiles and the
         device allow, :class:`.launch.Launcher`); the results do not depend on it.
+    kernel : str, optional
+        The minimisation kernel: ``"tiles"`` (the default) or ``"resident"`` (:class:`.launch.Launcher`); the
+        results do not depend on it.
     """
 
     name = "cuda"
     summary = "NVIDIA GPU (numba-cuda): whole minimisations on the device, batches of runs in one launch"
 
-    def __init__(self, threads=1, member=None, groups=None):
+    def __init__(self, threads=1, member=None, groups=None, kernel="tiles"):
         self.threads = int(threads)
         self.member = member
         self.groups = groups
+        self.kernel = kernel
         self.model = self.batch = self.slot = self.mesh = None
         self.device_mesh = None
+        self._epsy = None  # the yield strains held (the host array they came from: a rollback may hold them again)
 
     @classmethod
     def unavailable(cls):
         return _why_not()
 
-    def prepare(self, model, mesh):
+    @staticmethod
+    def run_ensemble(runs, groups=None):
+        """Run several simulations of one mesh on the GPU together: :func:`run_ensemble`."""
+        return run_ensemble(runs, groups)
+
+    def prepare(self, model, mesh, epsy):
         from .batch import DeviceBatch  # numba-cuda is optional: imported when a run asks for it
         from .device import DeviceMesh
 
         if self.member is not None:
-            return self.bound(model, mesh, self.member.ensemble.batch_for(model, mesh))
+            return self.bound(model, mesh, self.member.ensemble.batch_for(model, mesh), epsy)
         return self.bound(model, mesh, DeviceBatch(self.device_mesh or DeviceMesh(model, mesh), model.law, 1,
-                                                   self.groups))
+                                                   self.groups, self.kernel), epsy)
 
-    def for_model(self, model):
+    def for_model(self, model, epsy):
         from .batch import DeviceBatch
 
         if self.member is not None:
-            return self.bound(model, self.mesh, self.member.ensemble.batch_for(model, self.mesh))
-        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups))
+            return self.bound(model, self.mesh, self.member.ensemble.batch_for(model, self.mesh), epsy)
+        return self.bound(model, self.mesh, DeviceBatch(self.batch.mesh, model.law, 1, self.groups, self.kernel), epsy)
 
-    def bound(self, model, mesh, batch):
-        """A backend for ``model`` on ``mesh`` in a free slot of ``batch``, at rest at the origin."""
-        bound = CudaBackend(self.threads, self.member, self.groups)
+    def bound(self, model, mesh, batch, epsy):
+        """A backend for ``model`` on ``mesh`` holding the yield strains ``epsy`` [ni, ny] in a free slot of ``batch``,
+        at rest at the origin."""
+        bound = CudaBackend(self.threads, self.member, self.groups, self.kernel)
         bound.model, bound.mesh, bound.batch, bound.device_mesh = model, mesh, batch, batch.mesh
         bound.slot = batch.attach(model, bound)
+        bound._epsy = epsy
+        batch.set_yield_strains(bound.slot, epsy, None)
         bound.set_state(np.zeros(model.ndof), np.zeros(model.layer_volume.size), 0.0, 0.0)
         return bound
 
@@ -130,15 +152,21 @@ class CudaBackend(Backend):
         self.batch.evaluate(self.slot, False)
 
     def set_yield_strains(self, epsy, shift=None):
-        self.model = self.model._replace(epsy=epsy)
+        self._epsy = epsy
         self.batch.set_yield_strains(self.slot, epsy, shift)
         self.batch.evaluate(self.slot, True)
 
     def checkpoint(self):
-        return self.batch.checkpoint(self.slot)
+        return Checkpoint(self.batch.checkpoint(self.slot), self._epsy)
 
     def rollback(self, token):
-        self.batch.rollback(self.slot, token)
+        if token.epsy is not self._epsy:  # other yield strains held since: held again (no evaluation: the state is
+            self._epsy = token.epsy       # copied back whole)
+            self.batch.set_yield_strains(self.slot, token.epsy, None)
+        self.batch.rollback(self.slot, token.device)
+
+    def wells_changed(self, token, shift=None, elements=None):
+        return self.batch.state.wells_changed(self.slot, token.device, shift, elements)
 
     def minimise(self, tol, niter_tol, max_iter, margin, record, quiet=0):
         return self.batch.minimise(self.slot, (tol, niter_tol, max_iter, margin, record, quiet), self.member)
@@ -154,7 +182,7 @@ class CudaBackend(Backend):
         return self.batch.wells_hold(self.slot)
 
 
-def run_ensemble(runs, groups=None):
+def run_ensemble(runs, groups=None, kernel="tiles"):
     """Run several simulations of one mesh on the GPU as one batch: one thread per run, shared launches.
 
     Parameters
@@ -164,6 +192,8 @@ def run_ensemble(runs, groups=None):
         :func:`stickslip.fem.run.simulate_to_file` with its parameters and output file).
     groups : int, optional
         Blocks per realisation at most (default: spread over the device).
+    kernel : str, optional
+        The minimisation kernel (:class:`CudaBackend`).
 
     Returns
     -------
@@ -177,13 +207,13 @@ def run_ensemble(runs, groups=None):
     """
     from .ensemble import Ensemble
 
-    ensemble = Ensemble(len(runs), groups)
+    ensemble = Ensemble(len(runs), groups, kernel)
     members = [ensemble.join() for _ in runs]  # every run is a member before any minimisation is launched
     results, errors = [None] * len(runs), [None] * len(runs)
 
     def one(i):
         try:
-            results[i] = runs[i](CudaBackend(member=members[i], groups=groups))
+            results[i] = runs[i](CudaBackend(member=members[i], groups=groups, kernel=kernel))
         except BaseException as error:  # reported after the others ended
             errors[i] = error
         finally:

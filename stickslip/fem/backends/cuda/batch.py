@@ -41,17 +41,20 @@ class DeviceBatch:
     size : int
     groups : int, optional
         Blocks per realisation of a minimisation at most (:class:`.launch.Launcher`).
+    kernel : str, optional
+        The minimisation kernel (:class:`.launch.Launcher`; default ``"tiles"``).
     """
 
-    def __init__(self, mesh, law, size, groups=None):
+    def __init__(self, mesh, law, size, groups=None, kernel="tiles"):
         self.mesh, self.law, self.size = mesh, law, int(size)
         self.state = DeviceState(mesh, size)
-        self.launcher = Launcher(mesh, law, groups)
+        self.launcher = Launcher(mesh, law, groups, kernel=kernel)
         self._free = list(range(self.size))
         self._lock = threading.Lock()
 
     def attach(self, model, owner):
-        """A free slot for ``model`` (its yield strains, drive stiffness); released when ``owner`` is collected."""
+        """A free slot for ``model`` (its drive stiffness; the owner gives it yield strains); released when ``owner``
+        is collected."""
         if not same_law(model.law, self.law):
             raise ValueError(f"a batch computes one law: {model.law!r} is not {self.law!r}")
         with self._lock:
@@ -60,7 +63,6 @@ class DeviceBatch:
             slot = self._free.pop(0)
         weakref.finalize(owner, self._release, slot)
         self.state.upload(slot, k_drive=float(model.k_drive), idx=np.zeros((model.iface_dofs.shape[0], 4), np.int64))
-        self.set_yield_strains(slot, model.epsy, None)
         return slot
 
     def _release(self, slot):

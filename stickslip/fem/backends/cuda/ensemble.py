@@ -42,10 +42,12 @@ class Ensemble:
         Runs.
     groups : int, optional
         Blocks per realisation at most (:class:`.launch.Launcher`).
+    kernel : str, optional
+        The minimisation kernel (:class:`.launch.Launcher`).
     """
 
-    def __init__(self, size, groups=None):
-        self.size, self.groups = int(size), groups
+    def __init__(self, size, groups=None, kernel="tiles"):
+        self.size, self.groups, self.kernel = int(size), groups, kernel
         self.mesh = None
         self._batches = []
         self._lock = threading.Lock()
@@ -122,6 +124,6 @@ class Ensemble:
             for batch in self._batches:
                 if same_law(batch.law, model.law):
                     return batch
-            batch = DeviceBatch(self.mesh, model.law, 2 * self.size, self.groups)
+            batch = DeviceBatch(self.mesh, model.law, 2 * self.size, self.groups, self.kernel)
             self._batches.append(batch)
             return batch

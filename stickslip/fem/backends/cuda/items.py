@@ -22,6 +22,12 @@ from ..cpu.dynamics import _verlet_velocity
 __all__ = ["build"]
 
 
+def _python(function):
+    """The plain Python function of a numba-compiled ``function`` (itself where numba's JIT is off:
+    ``NUMBA_DISABLE_JIT=1``, as in the GPU check's smoke mode)."""
+    return getattr(function, "py_func", function)
+
+
 def build(jit, law_class):
     """The work items compiled by ``jit`` for laws of class ``law_class``.
 
@@ -38,11 +44,11 @@ def build(jit, law_class):
         ``plate_rows``, ``interface_element``, ``gathered``, ``predict``, ``verlet``, ``residual_terms``,
         and the scalar references ``equivalent`` (strain) and ``well`` (search).
     """
-    equivalent = jit(equivalent_strain.py_func)
-    strain_of = jit(element_strain.py_func)
-    well = jit(well_index.py_func)
-    verlet = jit(_verlet_velocity.py_func)
-    factor = jit(law_class.deviatoric_factor.py_func)
+    equivalent = jit(_python(equivalent_strain))
+    strain_of = jit(_python(element_strain))
+    well = jit(_python(well_index))
+    verlet = jit(_python(_verlet_velocity))
+    factor = jit(_python(law_class.deviatoric_factor))
 
     def plate_rows(coef, target, b, nb, lo, hi, u):
         """The node's two rows of ``K_p u`` from its stencil triplets ``lo:hi`` (the CPU's ``_triplet`` order).
@@ -67,13 +73,15 @@ def build(jit, law_class):
                 fy += gy
         return fx, fy
 
-    def interface_element(law, e, u, dofs, dNdx, dV, epsy, ny, idx, eps, sig, fe, owner, update_wells, ue, strain):
+    def interface_element(law, e, u, dofs, dNdx, dV, epsy, ny, idx, eps, sig, fe, owner, update_wells, store, ue,
+                          strain):
         """Strain, well, stress and element force of interface element ``e`` (:mod:`..cpu.interface_elements`).
 
         ``epsy`` [ni, >= ny] the held yield strains; ``fe`` [8] receives the element force; the element's
-        strain, stress and well are written if ``owner`` (another tile may compute the same element: the well
-        search does not depend on where it starts, so both find the same wells). ``ue`` [8], ``strain`` [4, 3]
-        scratch. Returns ``(moved, top)``: 1 if a Gauss point changed well, and the largest well of the element.
+        well is written if ``owner``, its strain and stress if ``owner`` and ``store`` (another tile may compute
+        the same element: the well search does not depend on where it starts, so both find the same wells).
+        ``ue`` [8], ``strain`` [4, 3] scratch. Returns ``(moved, top)``: 1 if a Gauss point changed well, and the
+        largest well of the element.
         """
         for a in range(8):
             ue[a] = u[dofs[e, a]]
@@ -97,7 +105,7 @@ def build(jit, law_class):
             strain[q, 0] = law.K * m + g * (xx - m)  # the strain's row now holds the stress
             strain[q, 1] = law.K * m + g * (yy - m)
             strain[q, 2] = g * xy
-            if owner:
+            if owner and store:
                 eps[e, q, 0] = xx
                 eps[e, q, 1] = yy
                 eps[e, q, 2] = xy

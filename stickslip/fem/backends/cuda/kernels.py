@@ -23,19 +23,24 @@ import numpy as np
 from numba import config, cuda, float64, int32, int64
 
 from ...laws import LAWS
-from . import items as items_module, minimise as minimise_module, sync as sync_module, tiles as tiles_module
+from . import items as items_module, minimise as minimise_module, resident as resident_module, sync as sync_module
+from . import tiles as tiles_module
 from .layout import LEAVES, MAX_LAYERS, MAX_TILE, MAX_TILE_ELEMENTS, MAX_TILE_TRIPLETS
 from .minimise import ROWS
 from .tiles import LAYER_ROW
 
-__all__ = ["kernels_for", "KERNELS", "MAX_REGISTERS"]
+__all__ = ["kernels_for", "KERNELS", "MAX_REGISTERS", "MINIMISERS"]
 
-#: Every kernel of :func:`kernels_for`.
-KERNELS = ("minimise", "prime", "layer_sums", "evaluate", "residual_rows", "residual", "wells_hold", "load", "add_u",
-           "shift_wells", "zero_motion")
+#: Every kernel of :func:`kernels_for`: the two minimisation kernels (:mod:`.minimise`, the default, and
+#: :mod:`.resident`), then the small ones.
+KERNELS = ("minimise", "resident", "prime", "layer_sums", "evaluate", "residual_rows", "residual", "wells_hold", "load",
+           "add_u", "shift_wells", "zero_motion")
 
-#: Registers per thread of the minimisation kernel at most (two blocks of 128 threads and more fit an SM).
+#: Registers per thread of the minimisation kernels at most (two blocks of 128 threads and more fit an SM).
 MAX_REGISTERS = 128
+
+#: The minimisation kernels by the name a backend chooses them with (``CudaBackend(kernel=...)``).
+MINIMISERS = {"tiles": "minimise", "resident": "resident"}
 
 if not hasattr(np, "row_stack"):
     # numba-cuda 0.30.4 overloads np.row_stack when its numpy support loads (at the first compilation); NumPy 2.5
@@ -92,7 +97,7 @@ def _small_kernels(device, items, sync, tiles, drive):
         drive(launch, mesh, state, m, leaves, drive_out)
         load_stencils(mesh, k, coef, target, t, bd)
         elements(law, mesh, k, state.u[m, 0], state, m, fe, flags, launch.update_wells, state.ny[m] + 1, False,
-                       t, bd, ue, strain)
+                 True, t, bd, ue, strain)
         force_nodes(mesh, k, m, state.u[m, 0], state, coef, target, fe, drive_out[1], rows, t, bd)
         publish(rows, LAYER_ROW, mesh.tile, state.partials[m, 1, k], t, bd)
         if k == 0 and t == 0:
@@ -167,7 +172,8 @@ def python_kernels(law_class, device=_device):
     sync = sync_module.build(device)
     tiles = tiles_module.build(device, items, sync)
     step = minimise_module.build(device, items, sync, tiles)
-    return {"minimise": step.minimise, **_small_kernels(device, items, sync, tiles, step.drive)}
+    return {"minimise": step.minimise, "resident": resident_module.build(device, items, sync, tiles, step),
+            **_small_kernels(device, items, sync, tiles, step.drive)}
 
 
 @functools.lru_cache(maxsize=None)
@@ -177,10 +183,11 @@ def kernels_for(law_name):
     Returns
     -------
     types.SimpleNamespace
-        One :func:`numba.cuda.jit` kernel per name of :data:`KERNELS`; the minimisation kernel with at most
+        One :func:`numba.cuda.jit` kernel per name of :data:`KERNELS`; the minimisation kernels with at most
         :data:`MAX_REGISTERS` registers per thread.
     """
     python = python_kernels(LAWS[law_name])
     capped = {} if config.ENABLE_CUDASIM else {"max_registers": MAX_REGISTERS}  # the simulator has no registers
-    compiled = {name: cuda.jit(function, **(capped if name == "minimise" else {})) for name, function in python.items()}
+    compiled = {name: cuda.jit(function, **(capped if name in MINIMISERS.values() else {}))
+                for name, function in python.items()}
     return SimpleNamespace(**compiled)

@@ -17,8 +17,9 @@ import numba
 import numpy as np
 from numba import config, cuda
 
-from .kernels import kernels_for
+from .kernels import MINIMISERS, kernels_for
 from .records import Launch
+from .resident import block_threads
 from .sync import BARRIER_TIMEOUT
 
 __all__ = ["Launcher", "BarrierTimeout", "LAUNCHES", "launching", "STEPS_PER_LAUNCH", "DEADLINE_CYCLES",
@@ -60,9 +61,10 @@ class BarrierTimeout(RuntimeError):
     """The blocks of a realisation did not all meet at a barrier within the deadline."""
 
 
-def threads_per_block(tile):
-    """Threads of a block: one per node of a tile on a GPU; 8 on numba's simulator (each a Python thread)."""
-    return min(8, tile) if config.ENABLE_CUDASIM else tile
+def threads_per_block(tile, elements=0):
+    """Threads of a block: one per node of a tile on a GPU, and per element of a tile where ``elements`` (the resident
+    kernel's, :func:`.resident.block_threads`); 8 on numba's simulator (each a Python thread)."""
+    return min(8, tile) if config.ENABLE_CUDASIM else block_threads(tile, elements)
 
 
 class Launcher:
@@ -78,6 +80,10 @@ class Launcher:
         device holds at once).
     deadline : int, optional
         Clock cycles of a barrier's wait (default :data:`DEADLINE_CYCLES`).
+    kernel : str, optional
+        The minimisation kernel (:data:`.kernels.MINIMISERS`): ``"tiles"`` (:mod:`.minimise`, the default) or
+        ``"resident"`` (:mod:`.resident`: a realisation over all its tiles' blocks, as many realisations per launch
+        as the device holds together, the others in further launches of the same call); the same bytes.
 
     Attributes
     ----------
@@ -85,12 +91,16 @@ class Launcher:
         Launches of the minimisation kernel by blocks per realisation.
     """
 
-    def __init__(self, mesh, law, groups=None, deadline=None):
-        self.mesh, self.law, self.groups = mesh, law, groups
+    def __init__(self, mesh, law, groups=None, deadline=None, kernel="tiles"):
+        if kernel not in MINIMISERS:
+            raise ValueError(f"cuda: the minimisation kernel must be one of {sorted(MINIMISERS)}; got {kernel!r}")
+        self.mesh, self.law, self.groups, self.kernel = mesh, law, groups, kernel
+        self.minimiser = MINIMISERS[kernel]
         self.deadline = int(DEADLINE_CYCLES if deadline is None else deadline)
         with LAUNCHES:  # the simulator swaps the kernel modules' ``cuda`` for its own during a launch
             self.kernels = kernels_for(type(law).name)
-        self.block = threads_per_block(mesh.layout.tile)
+        elements = int(np.diff(mesh.host.tile_element_ptr).max()) if kernel == "resident" else 0
+        self.block = threads_per_block(mesh.layout.tile, elements)
         self.groups_used = collections.Counter()
         self._capacity = None
 
@@ -103,7 +113,7 @@ class Launcher:
     def co_resident(self, arguments):
         """Blocks of the minimisation kernel the device holds at once (asked of the compiled kernel once)."""
         if self._capacity is None:
-            kernel = self.kernels.minimise
+            kernel = getattr(self.kernels, self.minimiser)
             if config.ENABLE_CUDASIM:
                 compiled = kernel.overloads[None]
             else:
@@ -111,11 +121,37 @@ class Launcher:
             self._capacity = int(compiled.max_cooperative_grid_blocks(self.block))
         return self._capacity
 
+    @property
+    def capacity(self):
+        """Blocks of the minimisation kernel the device holds at once (None before the first launch)."""
+        return self._capacity
+
     def groups_for(self, count, arguments):
-        """Blocks per realisation for a launch of ``count`` realisations: all co-resident if more than one."""
+        """Blocks per realisation for a launch of ``count`` realisations: all co-resident if more than one (the
+        resident kernel: every tile's block)."""
         ntile = self.mesh.layout.ntile
+        if self.kernel == "resident":
+            return ntile
         wanted = min(self.groups or ntile, ntile)
         return max(1, min(wanted, self.co_resident(arguments) // count))
+
+    def per_launch(self, arguments):
+        """Realisations one launch of the minimisation kernel holds at most (the resident kernel's co-resident
+        realisations; every one for the other kernel).
+
+        Raises
+        ------
+        ValueError
+            If the device cannot hold the blocks of one realisation of the resident kernel at once.
+        """
+        if self.kernel != "resident":
+            return sys.maxsize
+        ntile = self.mesh.layout.ntile
+        capacity = self.co_resident(arguments)
+        if ntile > 1 and capacity < ntile:
+            raise ValueError(f"cuda: the resident kernel needs the {ntile} blocks of a realisation at once; the device "
+                             f"holds {capacity} (choose kernel='tiles')")
+        return max(1, capacity // ntile) if ntile > 1 else sys.maxsize
 
     def arguments(self, name, slots, state, nsteps=0, update_wells=True, extra=()):
         """The arguments of a launch of kernel ``name`` for ``slots`` (also for compiling without a device).
@@ -125,26 +161,34 @@ class Launcher:
         """
         if name in ("add_u", "shift_wells", "zero_motion"):
             return (int(slots[0]), *extra, state.record())
-        head = (self.law,) if name in ("minimise", "evaluate") else ()
-        tail = (state.control_record(),) if name == "minimise" else ()
+        head = (self.law,) if name in ("minimise", "resident", "evaluate") else ()
+        tail = (state.control_record(),) if name in ("minimise", "resident") else ()
         return (*head, self.record(slots, 1, nsteps, update_wells), self.mesh.layout, state.record(), *tail, *extra)
 
     def minimise(self, slots, state, nsteps=None):
         """One launch of at most ``nsteps`` (default :data:`STEPS_PER_LAUNCH`) time steps of the minimisation kernel
-        for ``slots``; their status words afterwards.
+        for ``slots`` (the resident kernel: as many launches as :meth:`per_launch` needs); their status words
+        afterwards.
 
         Raises
         ------
         BarrierTimeout
             If a realisation's blocks did not meet at a barrier.
+        ValueError
+            If the device cannot hold the blocks of one realisation of the resident kernel at once.
         """
+        nsteps = STEPS_PER_LAUNCH if nsteps is None else nsteps
         with launching():
-            arguments = list(self.arguments("minimise", slots, state, STEPS_PER_LAUNCH if nsteps is None else nsteps))
-            G = self.groups_for(len(slots), arguments)
-            arguments[1] = arguments[1]._replace(groups=G)
-            state.reset_counters()
-            self.kernels.minimise[len(slots) * G, self.block](*arguments)
-            self.groups_used[G] += 1
+            arguments = list(self.arguments(self.minimiser, slots, state, nsteps))
+            size = self.per_launch(arguments)
+            for first in range(0, len(slots), size):
+                chunk = list(slots[first:first + size])
+                arguments = list(self.arguments(self.minimiser, chunk, state, nsteps))
+                G = self.groups_for(len(chunk), arguments)
+                arguments[1] = arguments[1]._replace(groups=G)
+                state.reset_counters()
+                getattr(self.kernels, self.minimiser)[len(chunk) * G, self.block](*arguments)
+                self.groups_used[G] += 1
         status = state.control["status"].copy_to_host()
         failed = [slot for slot in slots if status[slot] == BARRIER_TIMEOUT]
         if failed:

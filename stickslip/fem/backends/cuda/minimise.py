@@ -173,6 +173,36 @@ def build(device, items, sync, tiles):
             control.last[m] = runs[4]
             state.clock[m] = time
 
+    @device
+    def resume(state, control, m, runs, shared, t):
+        """A launch's start: the realisation's counters into ``runs`` [5] and (thread 0) its event count into
+        ``shared[1]``; returns its steps done, whether the last was judged, its clock, and the well a Gauss point
+        may reach before the margin stops it."""
+        for j in range(4):
+            runs[j] = control.runs[m, j]
+        runs[4] = control.last[m]
+        if t == 0:
+            shared[1] = control.nevent[m]
+        margin = control.margin[m]
+        limit = state.ny[m] - margin if margin > 0 else state.ny[m] + 1
+        return control.done[m], control.judged[m], state.clock[m], limit
+
+    @device
+    def start(launch, mesh, state, control, m, part, G, done, judged, time, leaves, counts, runs, shared, drive_out, t,
+              bd):
+        """The sums of step ``done`` and, if it was not judged (a full event buffer stopped the last launch before),
+        the drive of its state and its verdict; returns the verdict (:data:`RUNNING` if judged) and ``judged``."""
+        verdict = RUNNING
+        if not judged:  # stopped before this step was judged (a full event buffer): the drive of its state first
+            sums(mesh, state, m, (done + 1) % 2, leaves, counts, t, bd)
+            drive(launch, mesh, state, m, leaves, drive_out)
+            sums(mesh, state, m, done % 2, leaves, counts, t, bd)
+            verdict = judge(mesh, state, control, m, part, G, done % 2, done, time, leaves, counts, runs, shared)
+            judged = 0 if verdict == EVENTS_FULL else 1
+        else:
+            sums(mesh, state, m, done % 2, leaves, counts, t, bd)
+        return verdict, judged
+
     def minimise(law, launch, mesh, state, control):
         """Up to ``launch.nsteps`` time steps of the minimisation of every listed realisation (module docstring)."""
         G = launch.groups
@@ -191,24 +221,10 @@ def build(device, items, sync, tiles):
         ue = cuda.local.array(8, float64)
         strain = cuda.local.array((4, 3), float64)
         runs = cuda.local.array(5, float64)  # control.runs, then the last residual
-        for j in range(4):
-            runs[j] = control.runs[m, j]
-        runs[4] = control.last[m]
-        if t == 0:
-            shared[1] = control.nevent[m]
-        done, judged, time = control.done[m], control.judged[m], state.clock[m]
-        margin = control.margin[m]
-        limit = state.ny[m] - margin if margin > 0 else state.ny[m] + 1
+        done, judged, time, limit = resume(state, control, m, runs, shared, t)
         nrows = LAYER_ROW + mesh.nlayer
-        verdict = RUNNING
-        if not judged:  # stopped before this step was judged (a full event buffer): the drive of its state first
-            sums(mesh, state, m, (done + 1) % 2, leaves, counts, t, bd)
-            drive(launch, mesh, state, m, leaves, drive_out)
-            sums(mesh, state, m, done % 2, leaves, counts, t, bd)
-            verdict = judge(mesh, state, control, m, part, G, done % 2, done, time, leaves, counts, runs, shared)
-            judged = 0 if verdict == EVENTS_FULL else 1
-        else:
-            sums(mesh, state, m, done % 2, leaves, counts, t, bd)
+        verdict, judged = start(launch, mesh, state, control, m, part, G, done, judged, time, leaves, counts, runs,
+                                shared, drive_out, t, bd)
         passed = 0
         steps = 0
         while verdict == RUNNING and steps < launch.nsteps:
@@ -219,7 +235,8 @@ def build(device, items, sync, tiles):
             time += launch.dt
             for k in range(part, mesh.ntile, G):
                 load_stencils(mesh, k, coef, target, t, bd)
-                elements(law, mesh, k, u, state, m, fe, flags, True, limit, control.record[m], t, bd, ue, strain)
+                elements(law, mesh, k, u, state, m, fe, flags, True, limit, control.record[m], True, t, bd, ue,
+                         strain)
                 step_nodes(mesh, k, m, u, u_next, state, launch.dt, coef, target, fe, drive_out[1], rows, nrows,
                                  t, bd)
                 for j in range(t, 3, bd):
@@ -236,4 +253,5 @@ def build(device, items, sync, tiles):
             judged = 0 if verdict == EVENTS_FULL else 1
         finish(mesh, state, control, m, part, G, verdict, done, judged, time, drive_out, runs, shared, counts)
 
-    return SimpleNamespace(minimise=minimise, drive=drive, sums=sums)
+    return SimpleNamespace(minimise=minimise, drive=drive, sums=sums, judge=judge, resume=resume, start=start,
+                           finish=finish)

@@ -3,17 +3,20 @@
 A :class:`DeviceState` holds the :class:`.records.State` and :class:`.records.Control` arrays of ``size``
 realisations of one mesh (``[size, ...]`` arrays; realisation ``slot`` is row ``slot``) and builds the
 records the kernels take. Arrays that grow (the held yield strains, the event buffers) are replaced by
-larger ones, their content kept, so a record is built for each launch.
+larger ones, their content kept, so a record is built for each launch. Whether a Gauss point changed well since a
+checkpoint is counted on the device (:meth:`DeviceState.wells_changed`, :mod:`.changed_wells`; one integer to the
+host).
 """
 
 import numpy as np
 from numba import cuda
 
+from .changed_wells import COUNT_THREADS, count_changed
+from .launch import launching
 from .minimise import ROWS
 from .records import CHECKPOINT_FIELDS, STATE_FIELDS, Control, State
 
 __all__ = ["DeviceState"]
-
 
 class DeviceState:
     """The state and minimisation control of ``size`` realisations of ``mesh`` on the device.
@@ -41,6 +44,9 @@ class DeviceState:
             k_drive=zeros(B), delta_u=zeros((B, ndof)), delta_target=zeros((B, nl)), delta_lever=zeros(B),
             partials=zeros((B, 2, h.ntile, ROWS)), flags=zeros((B, 2, h.ntile, 3), np.int64),
             previous=zeros((B, ni), np.int64), scalar=zeros(B), flag=zeros(B, np.int64))
+        self._every = self.place(np.arange(ni, dtype=np.int64))  # all elements, and no renumbering
+        self._unshifted = zeros(ni, np.int64)
+        self._changed = zeros(B, np.int64)  # one count per slot: the runs of an ensemble count at once
         self.control = dict(
             tol=zeros(B), niter_tol=zeros(B, np.int64), max_iter=zeros(B, np.int64), margin=zeros(B, np.int64),
             quiet=zeros(B, np.int64), record=zeros(B, np.int64), done=zeros(B, np.int64), judged=zeros(B, np.int64),
@@ -95,6 +101,19 @@ class DeviceState:
         """Restore a :meth:`checkpoint`."""
         for name, kept in token.items():
             self.arrays[name][slot:slot + 1].copy_to_device(kept)
+
+    def wells_changed(self, slot, token, shift=None, elements=None):
+        """How many Gauss points of the slot are in another well than at :meth:`checkpoint` ``token`` (counted on the
+        device; ``shift``, ``elements`` as :meth:`..base.Backend.wells_changed`)."""
+        elements = self._every if elements is None else self.place(np.asarray(elements, dtype=np.int64))
+        shift = self._unshifted if shift is None else self.place(np.asarray(shift, dtype=np.int64))
+        count = self._changed[slot:slot + 1]
+        count.copy_to_device(np.zeros(1, dtype=np.int64))
+        points = 4 * elements.size
+        with launching():  # as every launch (the simulator's are not safe from two threads at once)
+            count_changed[max(1, -(-points // COUNT_THREADS)), COUNT_THREADS](self.arrays["idx"][slot],
+                                                                               token["idx"][0], shift, elements, count)
+        return int(count.copy_to_host()[0])
 
     def hold_yield_strains(self, slot, epsy):
         """Hold ``epsy`` [ni, ny] in the slot (the batch's window widened as needed: call between launches)."""

@@ -45,8 +45,9 @@ def build(device, items, sync):
             coef[j, c] = mesh.triplet_coef[triplet, c]
             target[j, c // 4, c % 4] = mesh.triplet_target[triplet, c // 4, c % 4]
 
-    def elements(law, mesh, k, u, state, m, fe, flags, update_wells, limit, record, t, bd, ue, strain):
-        """Tile ``k``'s interface elements into ``fe`` [., 8]; its flags (owned elements) into ``flags`` [3]."""
+    def elements(law, mesh, k, u, state, m, fe, flags, update_wells, limit, record, store, t, bd, ue, strain):
+        """Tile ``k``'s interface elements into ``fe`` [., 8]; its flags (owned elements) into ``flags`` [3]; the
+        strain and stress of the elements it owns into the state if ``store``."""
         if t == 0:
             flags[0] = 0
             flags[1] = 0
@@ -59,7 +60,7 @@ def build(device, items, sync):
             owner = mesh.tile_owns[lo + j]
             moved, top = interface_element(law, e, u, mesh.iface_dofs, mesh.iface_dNdx, mesh.iface_dV, state.epsy[m],
                                            ny, state.idx[m], state.eps[m], state.sig[m], fe[j], owner, update_wells,
-                                           ue, strain)
+                                           store, ue, strain)
             if owner:
                 if moved:
                     cuda.atomic.max(flags, 0, 1)
@@ -72,8 +73,13 @@ def build(device, items, sync):
     @device
     def node_force(mesh, n, u, coef, target, fe, scale):
         """Node ``n``'s force ``(x, y)``: its plate rows, its interface terms in element order, its drive term."""
-        fx, fy = plate_rows(coef, target, mesh.slot_stencil[n, 0], mesh.slot_stencil[n, 1], mesh.slot_stencil[n, 2],
-                            mesh.slot_stencil[n, 3], u)
+        return stencil_force(mesh, n, mesh.slot_stencil[n, 0], mesh.slot_stencil[n, 1], mesh.slot_stencil[n, 2],
+                             mesh.slot_stencil[n, 3], u, coef, target, fe, scale)
+
+    @device
+    def stencil_force(mesh, n, b, nb, lo, hi, u, coef, target, fe, scale):
+        """:func:`node_force` with the node's stencil row ``(b, nb, lo, hi)`` (``slot_stencil[n]``) given."""
+        fx, fy = plate_rows(coef, target, b, nb, lo, hi, u)
         fx = gathered(fx, mesh.slot_gather[n, 0], fe)
         fy = gathered(fy, mesh.slot_gather[n, 1], fe)
         for j in range(2):
@@ -143,5 +149,6 @@ def build(device, items, sync):
                 layer_rows(mesh, n, u_next[2 * n] if predicted else u[2 * n], rows, s)
 
     return SimpleNamespace(load_stencils=device(load_stencils), elements=device(elements), publish=publish,
+                           clear=clear, layer_rows=layer_rows, stencil_force=stencil_force,
                            step_nodes=device(step_nodes), force_nodes=device(force_nodes),
                            state_rows=device(state_rows))
