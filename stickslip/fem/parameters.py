@@ -175,14 +175,12 @@ class FemParams:
                                                       "interface; empty: 1 (the paper's). An interface of scale s "
                                                       "peaks and drops s times higher, its barriers s^2 times "
                                                       "(docs/fem.md, 'Interfaces of different strength')",
-                                                  exclusive_minimum=0.0, extension=True)
+                                                  minimum=0.1, maximum=10.0, extension=True)
 
     def check(self):
         """Check conditions across fields."""
-        self._check_law()
-        if len(self.interface_strength) not in (0, 1, self.plates - 1):
-            raise ParameterError(f"parameter 'interface_strength': expected one value or one per interface (plates - 1 "
-                                 f"= {self.plates - 1}), got {len(self.interface_strength)}")
+        _refuse_law_mismatch(self)
+        _refuse_strength_count(self)
         if self.temperature > 0.0 and self.yield_strains != "extend":
             raise ParameterError("parameter 'yield_strains': a thermal run (temperature > 0) needs 'extend'")
         if self.hold_delay != 0.0 and not self.hold_times:
@@ -221,19 +219,27 @@ class FemParams:
         _refuse_beyond_clock(self, "junction_attempt_rate", self.junction_attempt_rate)
         _refuse_endless_redraws(self)
 
-    def _check_law(self):
-        law = INTERFACE_LAWS[self.interface_law]
-        try:
-            make_law(law.name, self.K, self.G, self.law_params)
-        except ValueError as error:
-            raise ParameterError(f"parameter 'law_params': {error}") from None
-        if self.relaxation == "exact" and not law.exact_relaxation:
-            raise ParameterError(f"parameter 'relaxation': law '{law.name}' has a curvature that the elastic stiffness "
-                                 "does not bound, so 'exact' cannot converge; expected 'dynamic'")
-        if self.temperature > 0.0 and not law.thermal:
-            raise ParameterError(f"parameter 'temperature': law '{law.name}' is not thermal (the exact sampling of "
-                                 "the hops needs an exact backward barrier and barriers quasi-concave in eps_eq "
-                                 "within a well); expected 0")
+def _refuse_law_mismatch(params):
+    """Raise ParameterError where the interface law cannot take the run's parameters, relaxation or temperature."""
+    law = INTERFACE_LAWS[params.interface_law]
+    try:
+        make_law(law.name, params.K, params.G, params.law_params)
+    except ValueError as error:
+        raise ParameterError(f"parameter 'law_params': {error}") from None
+    if params.relaxation == "exact" and not law.exact_relaxation:
+        raise ParameterError(f"parameter 'relaxation': law '{law.name}' has a curvature that the elastic stiffness "
+                             "does not bound, so 'exact' cannot converge; expected 'dynamic'")
+    if params.temperature > 0.0 and not law.thermal:
+        raise ParameterError(f"parameter 'temperature': law '{law.name}' is not thermal (the exact sampling of "
+                             "the hops needs an exact backward barrier and barriers quasi-concave in eps_eq "
+                             "within a well); expected 0")
+
+
+def _refuse_strength_count(params):
+    """Raise ParameterError unless ``interface_strength`` has no value, one, or one per interface."""
+    if len(params.interface_strength) not in (0, 1, params.plates - 1):
+        raise ParameterError(f"parameter 'interface_strength': expected one value or one per interface (plates - 1 "
+                             f"= {params.plates - 1}), got {len(params.interface_strength)}")
 
 
 def _refuse_inconsistent_numerics(params):
