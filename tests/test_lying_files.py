@@ -197,6 +197,7 @@ def test_a_damaged_stored_parameter_names_the_file_and_says_damaged(tmp_path, ca
     where = data.index(b'"drive": "fixed-lever"') + len('"drive": "fix')
     data[where] ^= 0x80
     output.write_bytes(bytes(data))
+    output.with_suffix(".provenance.json").unlink()  # a copy of the run without its record
     capsys.readouterr()
     with open_file(output) as file:
         from stickslip.fem.parameters import stored_params
@@ -204,6 +205,9 @@ def test_a_damaged_stored_parameter_names_the_file_and_says_damaged(tmp_path, ca
         with pytest.raises(FileFormatError, match=f"{output}: attribute 'params' holds parameters no fem run has "
                                                   r"\(parameter 'drive': .* is not allowed"):
             stored_params(file)
+    with pytest.raises(FileFormatError, match=f"{output}: attribute 'params' holds parameters no fem run has "
+                                              r"\(parameter 'drive': .* is not allowed"):
+        stickslip.open_run(output).run_id  # no record beside it: the id from the stored parameters
     assert main(args) == 2
     error = _one_line(capsys)
     assert error.startswith(f"stickslip: error: {output}: holds a fem-run file of solver fem 4 that is damaged: its "
