@@ -100,8 +100,9 @@ def test_a_fem_state_is_the_stored_state_with_the_fields_the_run_observed(fem_ru
     previous = run.state(43)
     state = run.state(44)  # a slip: every block changed well
     with h5py.File(cli, "r") as file:
-        u, target, lever_target, t, _ = fem_run.RunFile(file).state(44)  # and the further state (none here)
-    assert np.array_equal(state.u, u) and np.array_equal(state.target, target) and state.t == t
+        stored = fem_run.RunFile(file).state(44)
+    u = stored.u
+    assert np.array_equal(state.u, u) and np.array_equal(state.target, stored.target) and state.t == stored.t
     assert state.displacement.shape == (run.mesh.nnode, 2)
     assert np.array_equal(state.displacement, u[run.mesh.dofs])
     assert state.eps.shape == state.sig.shape == (1, N, 4, 3) and state.well.shape == (1, N, 4)

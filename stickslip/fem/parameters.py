@@ -189,23 +189,10 @@ class FemParams:
                     raise ParameterError(f"parameter '{name}': used only with temperature > 0; expected a "
                                          "temperature > 0 or the default")
         self._check_junctions()
-        if self.niter_tol > self.max_iter:
-            raise ParameterError(f"parameter 'niter_tol': {self.niter_tol} consecutive steps cannot fit in max_iter = "
-                                 f"{self.max_iter} steps; expected niter_tol <= max_iter")
-        if self.yield_strains == "extend" and self.eps_offset <= self.deps * self.eps0:
-            raise ParameterError(f"parameter 'eps_offset': {self.eps_offset:g} lets a well be no wider than the kick "
-                                 f"deps * eps0 = {self.deps * self.eps0:g} (with yield_strains 'extend' any well may "
-                                 "be as narrow as eps_offset); expected eps_offset > deps * eps0")
-        if self.nchunk <= 2 * self.margin:
-            raise ParameterError(f"parameter 'nchunk': {self.nchunk} leaves no wells beyond the stop margin "
-                                 f"(margin = {self.margin}); expected nchunk > 2 * margin")
+        _refuse_inconsistent_numerics(self)
         if self.temperature > 0.0:  # warnings last: a refused run is one line
             _warn_reach(self)
-            if self.junction_strengthening > 0.0 and self.junction_glass_temperature <= self.temperature:
-                warnings.warn(f"parameters 'junction_glass_temperature', 'temperature': T_g = "
-                              f"{self.junction_glass_temperature:g} <= T = {self.temperature:g}: the junctions do not "
-                              "age (their depth saturates at once) and are redrawn at a rate that does not decay "
-                              "(docs/fem.md, 'Junction aging')", ParameterWarning, stacklevel=2)
+            _warn_glass_temperature(self)
 
     def _check_junctions(self):
         if self.junction_strengthening == 0.0:
@@ -239,6 +226,29 @@ class FemParams:
                                  "the hops needs an exact backward barrier and barriers quasi-concave in eps_eq "
                                  "within a well); expected 0")
 
+
+def _refuse_inconsistent_numerics(params):
+    """Raise ParameterError where the numerical parameters contradict each other (the minimisation's stop, the
+    narrowest well against the kick, the wells held against the stop margin)."""
+    if params.niter_tol > params.max_iter:
+        raise ParameterError(f"parameter 'niter_tol': {params.niter_tol} consecutive steps cannot fit in max_iter = "
+                             f"{params.max_iter} steps; expected niter_tol <= max_iter")
+    if params.yield_strains == "extend" and params.eps_offset <= params.deps * params.eps0:
+        raise ParameterError(f"parameter 'eps_offset': {params.eps_offset:g} lets a well be no wider than the kick "
+                             f"deps * eps0 = {params.deps * params.eps0:g} (with yield_strains 'extend' any well may "
+                             "be as narrow as eps_offset); expected eps_offset > deps * eps0")
+    if params.nchunk <= 2 * params.margin:
+        raise ParameterError(f"parameter 'nchunk': {params.nchunk} leaves no wells beyond the stop margin "
+                             f"(margin = {params.margin}); expected nchunk > 2 * margin")
+
+
+def _warn_glass_temperature(params):
+    """Warn where junction aging's glass temperature is not above the temperature (the junctions do not age)."""
+    if params.junction_strengthening > 0.0 and params.junction_glass_temperature <= params.temperature:
+        warnings.warn(f"parameters 'junction_glass_temperature', 'temperature': T_g = "
+                      f"{params.junction_glass_temperature:g} <= T = {params.temperature:g}: the junctions do not "
+                      "age (their depth saturates at once) and are redrawn at a rate that does not decay "
+                      "(docs/fem.md, 'Junction aging')", ParameterWarning, stacklevel=2)
 
 def _stretch(params):
     """The longest stretch of a thermal run's time: a stick-slip cycle or its longest hold [time], and its name."""
