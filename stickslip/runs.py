@@ -72,7 +72,13 @@ class _Run:
     def run_id(self):
         """The run's id (16 hexadecimal characters): its record's, else the id its solver, solver version and
         parameters give (:func:`stickslip.registry.run_id`, as the workflow names its file); None for a lab
-        recording or a solver that is not installed at the file's version."""
+        recording or a solver that is not installed at the file's version.
+
+        Raises
+        ------
+        stickslip.h5io.FileFormatError
+            If the stored parameters are not those of any run of the solver (a damaged file, named).
+        """
         if self.provenance is not None:
             return self.provenance["run_id"]
         try:
@@ -81,7 +87,7 @@ class _Run:
             return None
         if plugin is None or str(self.header.get("solver_version")) != str(plugin.version):
             return None
-        return registry.run_id(plugin, parse_params(plugin.params, self.params, owner=f"solver '{plugin.name}'"))
+        return registry.run_id(plugin, formats.stored_run_params(plugin.params, self.params, self.path, plugin.name))
 
 
 @dataclasses.dataclass(frozen=True)

@@ -85,7 +85,8 @@ class Visit:
         self.check()
 
     def check(self):
-        """Not blank: a heading and text; every image drawn."""
+        """Not blank: a heading and text; every image drawn (once the page after a click has loaded)."""
+        self.page.wait_for_load_state("load")
         assert self.page.locator("h1").count() == 1 and len(self.page.inner_text("main")) > 100, self.page.url
         broken = self.page.evaluate("Array.from(document.images).filter(i => !(i.complete && i.naturalWidth > 0))"
                                     ".map(i => i.src)")

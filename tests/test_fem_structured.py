@@ -1,5 +1,7 @@
 """The structured plate kernel equals the assembled product, for every mesh shape."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -51,23 +53,44 @@ def test_stencils_equal_the_assembled_product_on_random_displacements(N, plates_
     assert np.abs(plates_only).max() < 1e-12
 
 
-def test_stencils_of_a_single_row_pair_are_the_element_stiffness():
-    # one regular row of N squares between two node lines: the stencil of a node is the sum of its
-    # two elements' blocks, whatever N (the wrap joins the last element to the first node)
-    mesh = build_stack_mesh(MeshParams(N=4, plates=2))
-    edofs = element_dofs(mesh.conn, mesh.dofs)
+def _element_stiffness(mesh):
+    """The element dofs [nelem, 8], the elements' elastic stiffness [nelem, 8, 8] and the dofs of ``mesh``."""
     dNdx, dV = shape_gradients(element_coordinates(mesh.coor, mesh.conn))
-    ndof = int(np.max(mesh.dofs)) + 1
-    ptr, col, val = assemble_csr(edofs, elastic_element_stiffness(dNdx, dV, 4.5, 1.0), ndof)
-    plan = plan_product(build_stencils(mesh, ptr, col, val), ndof)
+    return element_dofs(mesh.conn, mesh.dofs), elastic_element_stiffness(dNdx, dV, 4.5, 1.0), int(np.max(mesh.dofs)) + 1
+
+
+def _stencil_and_dense_products(mesh):
+    """The stencil product and the dense matrix's product of the plates of ``mesh`` on random displacements."""
+    edofs, ke, ndof = _element_stiffness(mesh)
+    plan = plan_product(build_stencils(mesh, *assemble_csr(edofs, ke, ndof)), ndof)
     u = np.random.default_rng(0).standard_normal(ndof)
     f = np.zeros(ndof)
     plate_product(plan.views, plan.groups, plan.triplet_ptr, plan.triplet_view, plan.triplet_coef, plan.empty_dofs,
                   np.zeros((4, max(plan.view_size, plan.output_size))), u, f)
     dense = np.zeros((ndof, ndof))
-    np.add.at(dense, (np.repeat(edofs, 8, axis=1), np.tile(edofs, (1, 8))),
-              elastic_element_stiffness(dNdx, dV, 4.5, 1.0).reshape(edofs.shape[0], 64))
-    np.testing.assert_allclose(f, dense @ u, rtol=0, atol=1e-12 * np.abs(dense @ u).max())
+    np.add.at(dense, (np.repeat(edofs, 8, axis=1), np.tile(edofs, (1, 8))), ke.reshape(edofs.shape[0], 64))
+    return f, dense @ u
+
+
+def test_stencils_of_a_single_row_pair_are_the_element_stiffness():
+    # one regular row of N squares between two node lines: the stencil of a node is the sum of its
+    # two elements' blocks, whatever N (the wrap joins the last element to the first node)
+    f, expected = _stencil_and_dense_products(build_stack_mesh(MeshParams(N=4, plates=2)))
+    np.testing.assert_allclose(f, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+
+
+def test_stencils_of_far_coordinates_allow_their_round_off_and_still_see_another_element():
+    # N = 13 122 (x up to 4.1e4) was a ValueError traceback of `stickslip simulate` ("rows differ between blocks"):
+    # coordinates far from 0 make the coefficients of equal elements differ by eps |x| / h. The same mesh at
+    # N = 54 shifted to x ~ 1e5 has that round-off (3e-12 of the largest coefficient), cheaply
+    mesh = build_stack_mesh(MeshParams(N=54, plates=2))
+    far = dataclasses.replace(mesh, coor=np.asarray(mesh.coor) + [1e5, 0.0])
+    f, expected = _stencil_and_dense_products(far)
+    np.testing.assert_allclose(f, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    edofs, ke, ndof = _element_stiffness(far)
+    ke[7] *= 1 + 1e-6  # one element a little stiffer: no longer one stencil block after block
+    with pytest.raises(ValueError, match="rows differ between blocks"):
+        build_stencils(far, *assemble_csr(edofs, ke, ndof))
 
 
 @pytest.mark.parametrize("threads", [2, 3])

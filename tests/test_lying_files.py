@@ -199,6 +199,7 @@ def test_a_damaged_stored_parameter_names_the_file_and_says_damaged(tmp_path, ca
     where = data.index(b'"drive": "fixed-lever"') + len('"drive": "fix')
     data[where] ^= 0x80
     output.write_bytes(bytes(data))
+    output.with_suffix(".provenance.json").unlink()  # a copy of the run without its record
     capsys.readouterr()
     with open_file(output) as file:
         from stickslip.fem.parameters import stored_params
@@ -206,6 +207,9 @@ def test_a_damaged_stored_parameter_names_the_file_and_says_damaged(tmp_path, ca
         with pytest.raises(FileFormatError, match=f"{output}: attribute 'params' holds parameters no fem run has "
                                                   r"\(parameter 'drive': .* is not allowed"):
             stored_params(file)
+    with pytest.raises(FileFormatError, match=f"{output}: attribute 'params' holds parameters no fem run has "
+                                              r"\(parameter 'drive': .* is not allowed"):
+        stickslip.open_run(output).run_id  # no record beside it: the id from the stored parameters
     assert main(args) == 2
     error = _one_line(capsys)
     assert error.startswith(f"stickslip: error: {output}: holds a fem-run file of solver fem 4 that is damaged: its "
@@ -221,3 +225,37 @@ def test_the_rows_a_killed_writer_left_beyond_nstored_are_not_read(run):
     assert len(stickslip.open_run(run).increments) == 41
     with open_file(run) as file:
         assert fem_run.RunFile(file).nstored == 41
+
+
+#: The command of a small real fem run (resumed by the same command).
+SIMULATE = ["simulate", "--solver", "fem", "--param", "N=9", "--param", "max_increments=2"]
+
+
+def _nothing_stored(file):
+    for group in ("increments", "state"):
+        for dataset in file[group].values():
+            dataset.resize(0, axis=0)
+    file.attrs["nstored"] = 0
+
+
+@pytest.mark.parametrize("mutate, expected", [
+    (_nothing_stored, "attribute 'nstored' is 0, but a fem run stores its increment 0 when its file is created"),
+    (lambda file: file["increments"].attrs.modify("columns", "[]"), "attribute 'columns' of /increments is [], "
+                                                                    "expected the names of its 21 datasets"),
+    (lambda file: file["increments"].attrs.modify("columns", '["increment", "kick", "yield_element", "t"]'),
+     "attribute 'columns' of /increments is ['increment', 'kick', 'yield_element', 't'], expected"),
+    (lambda file: file.attrs.create("solver_version", np.arange(3)), "holds a fem-run file of solver fem [0, 1, 2] "
+                                                                     "(this run: solver_version '4')"),
+], ids=["nstored 0", "no columns", "fewer columns", "solver_version an array"])
+def test_a_resume_of_a_lying_run_is_one_line(mutate, expected, tmp_path, capsys):
+    # found by benchmarks/fuzz_files.py --seed 59: an IndexError, a KeyError ('kick') and a ValueError (an array's
+    # truth value) traceback of the resume
+    output = tmp_path / "run.h5"
+    assert main([*SIMULATE, "-o", str(output)]) == 0
+    with h5py.File(output, "r+") as file:
+        file.attrs["completed"] = False
+        mutate(file)
+    capsys.readouterr()
+    assert main([*SIMULATE, "-o", str(output)]) == 2
+    error = _one_line(capsys)
+    assert error.startswith(f"stickslip: error: {output}: ") and expected in error, error

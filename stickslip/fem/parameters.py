@@ -9,8 +9,8 @@ import dataclasses
 import math
 import warnings
 
+from .. import formats
 from ..formats import fem_run
-from ..h5io import FileFormatError
 from ..plugin_params import ParameterError, ParameterWarning, param, parse_params
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
@@ -333,10 +333,4 @@ def stored_params(file):
         If the file is not a ``fem-run`` file of the current version, or its parameters are not those of a
         :class:`FemParams` (a damaged file: the message names it).
     """
-    stored = fem_run.read_params(file)
-    try:
-        return parse_params(FemParams, stored, owner=f"{file.filename}: params")
-    except ParameterError as error:
-        raise FileFormatError(f"{file.filename}: attribute 'params' holds parameters no fem run has ({error}): the "
-                              "file is damaged or not what it claims; remake it (rerun the job that wrote "
-                              "it)") from None
+    return formats.stored_run_params(FemParams, fem_run.read_params(file), file.filename, "fem")

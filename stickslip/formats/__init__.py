@@ -37,9 +37,10 @@ import importlib
 import re
 
 from ..h5io import FileFormatError, attribute
+from ..plugin_params import ParameterError, parse_params
 
 __all__ = ["Format", "FormatError", "register_format", "get_format", "available_formats", "stamp", "check",
-           "describe"]
+           "describe", "stored_run_params"]
 
 _NAME = re.compile(r"^[a-z][a-z0-9-]*$")
 
@@ -179,6 +180,38 @@ def check(file, name):
         raise FileFormatError(f"{file.filename}: a {found} file version {version}, expected {name} version "
                               f"{fmt.version}")
     return True
+
+
+def stored_run_params(params_class, stored, path, solver):
+    """The parameters a solver's output file stores, validated: parameters that no run has are a damaged file.
+
+    Parameters
+    ----------
+    params_class : type
+        The solver's parameter dataclass (:mod:`stickslip.plugin_params`).
+    stored : Mapping[str, object]
+        The file's attribute ``params``, decoded.
+    path : str or pathlib.Path
+        The file, for the message.
+    solver : str
+        The solver's name, for the message.
+
+    Returns
+    -------
+    object
+        An instance of ``params_class``.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file as damaged, with the parameter that no run has (a flipped bit in the stored text reads
+        otherwise as the user's wrong parameter).
+    """
+    try:
+        return parse_params(params_class, stored, owner=f"{path}: params")
+    except ParameterError as error:
+        raise FileFormatError(f"{path}: attribute 'params' holds parameters no {solver} run has ({error}): the file "
+                              "is damaged or not what it claims; remake it (rerun the job that wrote it)") from None
 
 
 def describe(name, path):

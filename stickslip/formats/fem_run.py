@@ -124,6 +124,9 @@ class StoredState(NamedTuple):
 #: The datasets of every file's stored state, by :class:`StoredState` field.
 _STATE = ("u", "target", "lever_target", "t")
 
+#: The first columns of every file's ``/increments`` table (the producer's columns follow).
+_FIRST_COLUMNS = ["increment", "kick", "yield_element"]
+
 
 def _check_header(header):
     """Raise ValueError naming every field of :data:`HEADER` that ``header`` lacks or mistypes."""
@@ -189,7 +192,7 @@ def create_file(file, header, mesh, linear_response, columns, dtypes=None, state
         shape = tuple(shape)
         write_dataset(state, name, np.zeros((0, *shape), dtype=dtype), maxshape=(None, *shape), chunks=(1, *shape))
     table = file.create_group("increments")
-    columns = ["increment", "kick", "yield_element"] + list(columns)
+    columns = _FIRST_COLUMNS + list(columns)
     dtypes = {"increment": np.int64, "kick": bool, "yield_element": bool, **(dtypes or {})}
     for name in columns:
         dtype = dtypes.get(name, np.int64 if name[:2] in ("S_", "A_") else np.float64)
@@ -391,7 +394,12 @@ class RunFile:
         self.params = read_params(file)
         self.mesh = load_mesh(file["mesh"])
         self.nstored = stored_increments(file)
+        if not self.nstored:
+            raise CorruptFileError(f"{file.filename}: attribute 'nstored' is 0, but a fem run stores its increment 0 "
+                                   "when its file is created: the file is damaged; remake it (rerun the job that "
+                                   "wrote it)")
         self._check_shapes()
+        self._check_columns()
 
     def _check_shapes(self):
         """Raise FileFormatError unless the linear response and the state have the shapes of the mesh (module
@@ -410,6 +418,17 @@ class RunFile:
                 raise FileFormatError(f"{self.file.filename}: /{name} is {what}, expected "
                                       f"{'rows of ' if per_row else ''}{shape} (the stored mesh's): the file is "
                                       "damaged")
+
+    def _check_columns(self):
+        """Raise CorruptFileError unless the attribute ``columns`` of ``/increments`` names its datasets, the
+        format's first (:func:`create_file`)."""
+        table = self.file["increments"]
+        columns = attribute(table, "columns", "json")
+        if not (isinstance(columns, list) and columns[:len(_FIRST_COLUMNS)] == _FIRST_COLUMNS
+                and sorted(columns) == sorted(table)):
+            raise CorruptFileError(f"{self.file.filename}: attribute 'columns' of /increments is {str(columns)[:80]}, "
+                                   f"expected the names of its {len(table)} datasets, {', '.join(_FIRST_COLUMNS)} "
+                                   "first: the file is damaged; remake it (rerun the job that wrote it)")
 
     def state(self, increment):
         """The :class:`StoredState` of a stored increment (its ``further`` empty in a file without further state)."""

@@ -114,9 +114,12 @@ def root_attributes(path, names):
 
 
 def _plain(value):
-    """An attribute as a Python value: text decoded, JSON objects and arrays parsed, numpy scalars unwrapped."""
+    """An attribute as a Python value: text decoded, JSON objects and arrays parsed, numpy scalars and arrays
+    unwrapped (a damaged file's array compares as a list, not elementwise)."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
     if isinstance(value, bytes):
-        value = value.decode()
+        value = value.decode("utf-8", "surrogateescape")
     if isinstance(value, str) and value[:1] in "{[":
         try:
             return json.loads(value)
