@@ -8,7 +8,7 @@ start on a disk without room (:func:`stickslip.output_safety.space.check_free_sp
 import math
 import resource
 
-__all__ = ["meminfo", "process_memory", "room_left", "size_text"]
+__all__ = ["meminfo", "process_memory", "resident_memory", "room_left", "size_text"]
 
 
 def meminfo(field):
@@ -40,6 +40,11 @@ def _limits():
         if soft != resource.RLIM_INFINITY:
             found.append((soft, used))
     return found
+
+
+def resident_memory():
+    """What this process holds in memory now (``VmRSS``) [B]; 0 where nothing says."""
+    return _own("VmRSS")
 
 
 def room_left():

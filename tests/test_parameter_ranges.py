@@ -25,7 +25,7 @@ from stickslip.errors import SolverError
 from stickslip.fem.memory import run_memory
 from stickslip.fem.parameters import FemParams
 from stickslip.h5io import open_file, read_array
-from stickslip.machine_memory import process_memory
+from stickslip.machine_memory import process_memory, size_text
 from stickslip.plugin_params import ParameterError, describe, params_to_dict, parse_params, value_range
 
 SOLVERS = ("fem", "lever", "rate-state-lever")
@@ -150,7 +150,8 @@ def test_a_run_that_needs_more_memory_than_the_machine_has_is_refused_with_the_e
     status = main(["simulate", "--solver", "fem", *(f"--param={k}={v}" for k, v in values.items()),
                    "-o", str(tmp_path / "run.h5")])
     error = capsys.readouterr().err.strip().splitlines()
-    assert status == 2 and len(error) == 1 and "the run needs at least 3.64 TiB of memory" in error[0], error
+    assert status == 2 and len(error) == 1 and f"the run needs at least {size_text(needed)} of memory" in error[0]
+    assert "(yield strains: 3.64 TiB)" in error[0], error
     status = main(["simulate", "--solver", "lever", "--param", "duration=1e9", "-o", str(tmp_path / "lab.h5")])
     error = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(error) == 1 and "the recording needs at least" in error[0], error

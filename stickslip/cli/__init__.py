@@ -4,7 +4,7 @@ Each module in :data:`COMMANDS` defines ``add_parser(subparsers)``, which adds i
 sub-command and sets ``func(args) -> int`` as the parser default. Errors of the
 user's making (bad parameter, unknown plugin, unreadable file, a run the solver cannot make with the
 parameters given) are printed as one line ``stickslip: error: ...`` with exit status 2, never as a
-traceback. Every command that writes a file refuses an existing output that holds another run unless
+traceback; so is a command that runs out of memory (naming the command and the sizes to lower). Every command that writes a file refuses an existing output that holds another run unless
 given ``--overwrite``. Ctrl-C and
 SIGTERM end a command cleanly (files closed, what a run stored is kept) with exit
 status 130 (SIGINT) or 143 (SIGTERM). Warnings of the package (parameters outside the studied regime)
@@ -20,6 +20,7 @@ import warnings
 from .. import __version__
 from ..errors import SolverError
 from ..h5io import FileFormatError
+from ..machine_memory import process_memory, size_text
 from ..output_safety.errors import OutputError
 from ..plugin_params import ParameterError, ParameterWarning
 from ..registry import PluginError
@@ -81,6 +82,15 @@ def _one_line_warning(message, category, filename, lineno, line=None):
 _python_warning = warnings.formatwarning
 
 
+def out_of_memory(args, error):
+    """The one line of a command that ran out of memory: what ran out, how much was asked (where Python says) and
+    what to do."""
+    asked = f" ({' '.join(str(error).split())})" if str(error) else ""
+    return (f"{args.command}: out of memory{asked}, more than this process can have ({size_text(process_memory())}); "
+            "use smaller sizes (a simulation: smaller N, plates, window, nchunk or niter_tol) or a machine with more "
+            "memory")
+
+
 def main(argv=None):
     """Run the command line; return the exit status."""
     warnings.formatwarning = _one_line_warning
@@ -91,6 +101,9 @@ def main(argv=None):
             return args.func(args) or 0
     except USER_ERRORS as error:
         print(f"stickslip: error: {' '.join(str(error).split())}", file=sys.stderr)
+        return 2
+    except MemoryError as error:
+        print(f"stickslip: error: {out_of_memory(args, error)}", file=sys.stderr)
         return 2
     except BaseException as error:
         interrupt = interruption(error)
