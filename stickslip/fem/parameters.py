@@ -11,7 +11,7 @@ import warnings
 
 from .. import formats
 from ..formats import fem_run
-from ..plugin_params import ParameterError, ParameterWarning, param, parse_params
+from ..plugin_params import ParameterError, ParameterWarning, param
 from .backends import BACKENDS, DEFAULT_BACKEND
 from .laws import INTERFACE_LAWS, make_law
 from .trap_model import expected_redraws
