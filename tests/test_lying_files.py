@@ -74,7 +74,7 @@ def _one_line(capsys):
     return lines[0]
 
 
-REFUSAL = textwrap.dedent("""
+REFUSAL = textwrap.dedent(r"""
     import re, sys, time
     import stickslip
     started = time.perf_counter()

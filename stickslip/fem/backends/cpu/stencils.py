@@ -39,8 +39,9 @@ __all__ = ["PlateStencils", "PlatePlan", "build_stencils", "plan_product", "bala
 _START, _P, _CLASS, _NB, _TSTART, _TP, _TCLASS, _DB = range(8)
 
 #: Round-off allowed between a stencil's coefficient at two blocks, in machine epsilons of the largest coefficient
-#: per block size of the largest coordinate: an element's geometry is computed from its nodes' coordinates, whose
-#: differences keep eps * |x| / h of their relative precision (N = 13 122: coefficients 1.3e-12 apart).
+#: times the largest coordinate over the finest element's edge h: an element's geometry is computed from its nodes'
+#: coordinates, whose differences keep eps * |x| / h of their relative precision (N = 13 122: coefficients 1.3e-12
+#: apart).
 _ROUND_OFF = 64
 
 
@@ -84,6 +85,11 @@ def _node_lines(mesh):
     return lines, line_of_dof, node_of_dof
 
 
+def _finest_edge(coor, conn):
+    """The shortest edge of the elements (first and second edge of every quadrilateral) [length]."""
+    corners = np.asarray(coor)[np.asarray(conn)[:, :3]]
+    return np.sqrt(((corners[:, 1:] - corners[:, :-1]) ** 2).sum(axis=2)).min()
+
 def build_stencils(mesh, ptr, col, val):
     """Stencils of the assembled plate stiffness of a layered mesh.
 
@@ -106,7 +112,8 @@ def build_stencils(mesh, ptr, col, val):
     lines, line_of_dof, node_of_dof = _node_lines(mesh)
     line_start = np.array([start for start, _ in lines], dtype=np.int64)
     line_n = np.array([n for _, n in lines], dtype=np.int64)
-    tolerance = _ROUND_OFF * np.finfo(float).eps * max(1.0, np.abs(mesh.coor).max() / mesh.h) * np.abs(val).max()
+    edge = _finest_edge(mesh.coor, mesh.conn)
+    tolerance = _ROUND_OFF * np.finfo(float).eps * max(1.0, np.abs(mesh.coor).max() / edge) * np.abs(val).max()
     index, coef = [], []
     for start, n in lines:
         first, last = ptr[start], ptr[start + 2 * n]
