@@ -21,7 +21,7 @@ import pytest
 from stickslip.statistics.calibration import (LAB_MEAN_LN, calibration_line, lab_clock, log_spread,
                                               merge_unresolved, over_seeds)
 from stickslip.statistics.estimator import estimator_table, lab_slips
-from stickslip.statistics.loading_contrast import loading_contrast
+from stickslip.statistics.loading_contrast import loading_contrast, slips_needed
 
 
 def _slip_table(times, peaks, drops, multi=None, interface=1):
@@ -145,3 +145,18 @@ def test_one_loading_path_per_interface_identifies_nothing():
         assert np.allclose(alone["T"] * rate, alone["dmu"], rtol=1e-9)
         result = loading_contrast(alone, t0=1.0)
         assert math.isnan(result["B"]) and "two loading paths" in result["reason"]
+
+
+def test_the_slips_a_loading_contrast_needs_follow_its_error():
+    B, shift, sd = 0.005, 0.4, 0.03
+    m = int(round(slips_needed(sd, B, shift)))
+    assert m == int(round(2 * (sd / (0.25 * B * shift)) ** 2))
+    rng = np.random.default_rng(5)
+    estimates = []
+    for _ in range(200):  # two paths of one interface, <ln T> apart by `shift`, drops B ln T + scatter `sd`
+        lnT = np.concatenate([np.full(m, 10.0), np.full(m, 10.0 + shift)]) + 0.01 * rng.standard_normal(2 * m)
+        slips = pd.DataFrame({"interface": 1, "n": np.repeat([1, 2], m), "T": np.exp(lnT), "multi": False,
+                              "dmu": B * lnT + sd * rng.standard_normal(2 * m)})
+        estimates.append(loading_contrast(slips, t0=1.0)["B"])
+    assert np.std(estimates) == pytest.approx(0.25 * B, rel=0.15)
+    assert slips_needed(sd, B, 0.0) == math.inf

@@ -20,6 +20,8 @@ interface with different ``<ln T>``; one path (n = 1 alone) identifies nothing. 
 drop only through the contacts' age: a direct dependence of the peak on the loading rate (rate-and-state's
 ``a ln V``, thermally activated depinning) enters as ``B - a_direct d ln(rate) / d <ln T>``, and a post-slip level
 that depends on the age enters as such (:func:`stickslip.statistics.estimator.lab_slips` with ``direct``; tested).
+(3) Reach: with two paths whose ``<ln T>`` differ by ``delta`` and drops scattered by ``sd``, the estimate's error is
+``sd sqrt(2 / m) / delta`` for ``m`` slips per path (:func:`slips_needed`).
 """
 
 import math
@@ -29,7 +31,7 @@ import pandas as pd
 
 from .lines import fit_line
 
-__all__ = ["CONTRAST_COLUMNS", "group_means", "loading_contrast"]
+__all__ = ["CONTRAST_COLUMNS", "group_means", "loading_contrast", "slips_needed"]
 
 #: Keys of :func:`loading_contrast`.
 CONTRAST_COLUMNS = ["B", "B_error", "c", "interfaces", "groups", "slips", "lnT_range", "reason"]
@@ -104,3 +106,30 @@ def loading_contrast(slips, *, t0, interface="interface", group="n", T="T", dmu=
         return out | {"reason": "the loading paths do not differ in <ln T>"}
     line = fit_line(means["x"], means["x_error"], means["y"], means["y_error"], groups=means["interface"].to_numpy())
     return out | {"B": line["B"], "B_error": line["B_error"], "c": float(np.mean(list(line["intercepts"].values())))}
+
+
+def slips_needed(drop_sd, B, lnT_shift, *, relative_error=0.25):
+    """Slips per loading path that two paths need for the contrast to measure ``B`` to ``relative_error``.
+
+    Wald's estimate ``(<dmu>_2 - <dmu>_1) / (<ln T>_2 - <ln T>_1)`` has the standard error
+    ``drop_sd sqrt(2 / m) / lnT_shift`` for ``m`` slips per path (the means of ``ln T`` taken as exact); setting it
+    to ``relative_error B`` gives ``m``.
+
+    Parameters
+    ----------
+    drop_sd : float
+        Standard deviation of an interface's drops within a path [unit of the drops].
+    B : float
+        The aging rate to measure [unit of the drops per e-fold of T].
+    lnT_shift : float
+        How far the paths' mean ``ln T`` lie apart [e-folds].
+    relative_error : float
+        The standard error wanted, relative to ``B``.
+
+    Returns
+    -------
+    float
+        ``2 (drop_sd / (relative_error B lnT_shift))^2`` (inf where the paths do not differ).
+    """
+    scale = relative_error * abs(B) * abs(lnT_shift)
+    return 2.0 * (drop_sd / scale) ** 2 if scale > 0 else math.inf
