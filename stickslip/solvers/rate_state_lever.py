@@ -2,7 +2,7 @@
 
 The apparatus, protocols, sensors and file format of the ``lever`` solver
 (:mod:`stickslip.solvers.lever`), but every slippable interface obeys rate-and-state friction with
-the aging law (:mod:`stickslip.experiment.virtual.rate_state`) and the slabs move by Newton's law
+the aging law, or the slip law with ``rs_state_law: slip`` (the aging-off control; :mod:`stickslip.experiment.virtual.rate_state`), and the slabs move by Newton's law
 (:mod:`stickslip.experiment.virtual.slab_dynamics`): sticks, slips, creep and any simultaneous
 slip follow from the equations, nothing is scheduled. Optionally (``path_disorder`` > 0) each interface's
 ``mu0`` varies along its slip path (:mod:`stickslip.experiment.virtual.slip_path`). Model, defaults and their sources:
@@ -24,6 +24,7 @@ import dataclasses
 
 from .. import registry
 from ..experiment.timeseries import write_timeseries
+from ..experiment.virtual.rate_state import STATE_LAWS
 from ..experiment.virtual.rate_state_model import simulate, slab_order
 from ..experiment.virtual.slab_dynamics import DEFAULT_METHOD, METHODS
 from ..plugin_params import ParameterError, param, params_to_dict
@@ -57,6 +58,9 @@ _OWN = [
     ("mu0", tuple[float, ...], param((0.35,), "steady friction at V0 per interface (one value: all)",
                                      minimum=1e-3, maximum=10)),
     ("V0", float, param(1e-3, "reference slip rate V0", unit="mm/s", minimum=1e-12, maximum=1e6)),
+    ("rs_state_law", str, param("aging", "evolution law of the state: aging (Dieterich: the contacts heal with time at "
+                                         "rest) or slip (Ruina: no healing at rest, the aging-off control)",
+                                choices=STATE_LAWS, extension=True)),
     ("disorder", float, param(0.05, "relative standard deviation of b and D_c drawn per interface and seed "
                                     "(quenched disorder; 0: none)", minimum=0, maximum=1)),
     ("path_disorder", float, param(0.0, "relative standard deviation of mu0 along each interface's slip path "
@@ -107,7 +111,7 @@ RateStateLeverParams.__doc__ = ("Parameters of one rate-and-state virtual run: t
 
 @registry.register("solver", "rate-state-lever", VERSION, RateStateLeverParams, produces="timeseries",
                    preflight=check_memory,
-                   summary="virtual lever experiment with inertial slabs on rate-and-state (aging law) interfaces")
+                   summary="virtual lever experiment with inertial slabs on rate-and-state (aging or slip law) interfaces")
 def run(params, output, *, threads, inputs):
     """Run one rate-and-state virtual experiment and write its time-series file with the ground truth."""
     signals, truth, interfaces, integration = simulate(params)

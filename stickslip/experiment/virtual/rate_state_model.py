@@ -45,7 +45,7 @@ def law_of(params):
     order = slab_order(params)
     return RateStateLaw(a=per_interface(params, "rs_a")[order], b=(per_interface(params, "rs_b") * spread[0])[order],
                         D_c=(per_interface(params, "D_c") * spread[1])[order], mu0=per_interface(params, "mu0")[order],
-                        V0=params.V0)
+                        V0=params.V0, state_law=params.rs_state_law)
 
 
 def dynamics_of(params):

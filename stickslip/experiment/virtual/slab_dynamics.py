@@ -156,7 +156,7 @@ class SlabDynamics:
 
     def _arrays(self):
         return (self._drive, self._stiffness, self._coupling, self._mu0, self._a, self._b, self._D_c,
-                float(self.law.V0), self._path)
+                float(self.law.V0), self._path, self.law.state_law == "slip")
 
     def slip_rates(self, mu, psi, R=None):
         """Slip rates [mm/s] of the slippable interfaces at friction coefficients ``mu``, states ``psi``

@@ -15,7 +15,7 @@ M^-1`` times the force matrices, see :class:`.slab_dynamics.SlabDynamics`), beco
 
     dR/dt = V
     dmu/dt = (a acc + V (b dpsi/dt + mu0'(R) V)) / W          W = w cosh(mu / a) = a dV/dmu
-    dpsi/dt = (V0 exp(-psi) - |V|) / D_c
+    dpsi/dt = (V0 exp(-psi) - |V|) / D_c                       (aging law; slip law: -|V| (ln(|V|/V0) + psi) / D_c)
     dgamma/dt = rate
 
 Why the friction and not the slip rate is the state: deep in a stick (``V`` ~ 1e-17 to 1e-13 mm/s)
@@ -31,7 +31,9 @@ also depends on the slip ``R``. ``V`` and ``W`` are computed from ``exp((±|mu| 
 which neither overflows nor underflows at the values a run reaches.
 
 The arguments after ``y`` are the same for every function here (``rate, drive, stiffness, coupling,
-mu0, a, b, D_c, V0, path``, see :func:`rhs`), so that the integrator passes one tuple to all of them.
+mu0, a, b, D_c, V0, path, slip_law``, see :func:`rhs`), so that the integrator passes one tuple to all of them.
+The aging law's expressions are those of the runs before the slip law was added, operation for operation (the same
+bits); the slip law's are separate (:func:`slip_law_state_rate`).
 """
 
 import math
@@ -41,7 +43,7 @@ import numpy as np
 from ...numba_options import njit
 from .slip_path import level
 
-__all__ = ["rhs", "rhs_into", "jacobian", "jacobian_into", "slip_rate", "slip_rates"]
+__all__ = ["rhs", "rhs_into", "jacobian", "jacobian_into", "slip_rate", "slip_rates", "slip_law_state_rate"]
 
 
 @njit
@@ -53,6 +55,27 @@ def slip_rate(mu, psi, mu0, a, b, V0):
     down = math.exp((-abs(mu) - level_psi) / a)
     V = V0 * (up - down)
     return (V if mu >= 0.0 else -V), V0 * (up + down)
+
+
+@njit
+def slip_law_state_rate(V, W, psi, a, b, D_c, V0, lam):
+    """The slip law's ``dpsi/dt = -|V| (x) / D_c``, ``x = ln(|V| / V0) + psi = ln(V theta / D_c)``, and its
+    derivatives in ``mu``, ``psi`` and ``R`` through ``V`` (``dV/dmu = W/a``, ``dV/dpsi = -b V/a``, ``dV/dR =
+    -lam V/a``; at ``V = 0`` all four are 0: the state stays at rest).
+
+    Returns
+    -------
+    tuple[float, float, float, float]
+        ``dpsi/dt`` [1/s] and its derivatives in ``mu`` [1/s], ``psi`` [1/s] and ``R`` [1/(s mm)].
+    """
+    if V == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    speed = abs(V)
+    x = math.log(speed / V0) + psi
+    by_speed = -(x + 1.0) / D_c              # d(dpsi/dt)/d|V| at fixed psi
+    sign = 1.0 if V > 0.0 else -1.0
+    return (-speed * x / D_c, by_speed * sign * W / a, -speed / D_c - by_speed * b * speed / a,
+            -by_speed * lam * speed / a)
 
 
 @njit
@@ -69,7 +92,7 @@ def slip_rates(R, mu, psi, mu0, a, b, V0, path):
 
 
 @njit
-def rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+def rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law):
     """dy/dt written into ``out`` (float64 [3 m + 1]; no allocation); arguments of :func:`rhs`."""
     m = mu0.size
     gamma = y[3 * m]
@@ -77,7 +100,10 @@ def rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
         level_k, level_slope, _ = level(k, y[k], mu0, path)
         V, W = slip_rate(y[m + k], y[2 * m + k], level_k, a[k], b[k], V0)
         out[k] = V
-        out[2 * m + k] = (V0 * math.exp(-y[2 * m + k]) - abs(V)) / D_c[k]
+        if slip_law:
+            out[2 * m + k] = slip_law_state_rate(V, W, y[2 * m + k], a[k], b[k], D_c[k], V0, level_slope)[0]
+        else:
+            out[2 * m + k] = (V0 * math.exp(-y[2 * m + k]) - abs(V)) / D_c[k]
         acceleration = drive[k] * gamma
         for j in range(m):
             acceleration -= stiffness[k, j] * y[j] + coupling[k, j] * y[m + j]
@@ -86,7 +112,7 @@ def rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
 
 
 @njit
-def rhs(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+def rhs(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law):
     """dy/dt, float64 [3 m + 1].
 
     Parameters
@@ -109,14 +135,17 @@ def rhs(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
     path : tuple
         Heterogeneity of ``mu0`` along the slip path (:func:`.slip_path.slip_path`;
         :func:`.slip_path.no_path`: none).
+    slip_law : bool
+        The state evolves by the slip law (True) or the aging law (False) on every interface
+        (:mod:`.rate_state`).
     """
     out = np.empty(y.size)
-    rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
+    rhs_into(y, out, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law)
     return out
 
 
 @njit
-def jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+def jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law):
     """d(dy/dt)/dy written into ``J`` (float64 [3 m + 1, 3 m + 1], overwritten); arguments of :func:`rhs`.
 
     With ``s = a / W``, ``tau = V / W = tanh(mu / a)``, ``lam = mu0'(R)``, ``Q = b dpsi/dt + lam V``,
@@ -135,11 +164,14 @@ def jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, pa
         tau = V / W
         sech2 = (2.0 * V0 * math.exp(-(level_k + bk * psi) / ak) / W) ** 2      # 1 - tau^2
         sign = 1.0 if V > 0.0 else (-1.0 if V < 0.0 else 0.0)
-        aging = V0 * math.exp(-psi)
-        psi_rate = (aging - abs(V)) / Dk
-        psi_by_mu = -sign * W / (ak * Dk)
-        psi_by_psi = (-aging + bk / ak * abs(V)) / Dk
-        psi_by_R = lam / ak * abs(V) / Dk
+        if slip_law:
+            psi_rate, psi_by_mu, psi_by_psi, psi_by_R = slip_law_state_rate(V, W, psi, ak, bk, Dk, V0, lam)
+        else:
+            aging = V0 * math.exp(-psi)
+            psi_rate = (aging - abs(V)) / Dk
+            psi_by_mu = -sign * W / (ak * Dk)
+            psi_by_psi = (-aging + bk / ak * abs(V)) / Dk
+            psi_by_R = lam / ak * abs(V) / Dk
         Q = bk * psi_rate + lam * V
         acceleration = drive[k] * gamma
         for j in range(m):
@@ -164,8 +196,8 @@ def jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, pa
 
 
 @njit
-def jacobian(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+def jacobian(y, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law):
     """d(dy/dt)/dy, float64 [3 m + 1, 3 m + 1]; arguments of :func:`rhs`."""
     J = np.empty((y.size, y.size))
-    jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
+    jacobian_into(y, J, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law)
     return J

@@ -31,7 +31,7 @@ def new_factors(n):
 
 
 @njit
-def factorize(y, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+def factorize(y, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law):
     """Factorise ``I - c J(y)`` into ``factors`` (from :func:`new_factors`), for :func:`solve`.
 
     Parameters
@@ -42,12 +42,12 @@ def factorize(y, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V
         ``gamma h`` of the Rosenbrock step [s].
     factors : tuple
         Work arrays, overwritten.
-    rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path
+    rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law
         Arguments of :func:`.slab_equations.rhs`.
     """
     lu, pivot, scale = factors
     n = y.size
-    jacobian_into(y, lu, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path)
+    jacobian_into(y, lu, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law)
     for i in range(n):
         largest = 0.0
         for k in range(n):
@@ -78,7 +78,7 @@ def factorize(y, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V
 
 
 @njit
-def solve(r, u, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path):
+def solve(r, u, c, factors, rate, drive, stiffness, coupling, mu0, a, b, D_c, V0, path, slip_law):
     """Solve ``(I - c J) u = r`` with the factors of :func:`factorize` (same ``c``); ``r`` and ``u``
     float64 [3 m + 1] (distinct arrays); returns None."""
     lu, pivot, scale = factors
