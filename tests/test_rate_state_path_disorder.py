@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicHermiteSpline
 
+from jacobian_check import central_differences
 from stickslip import registry
 from stickslip.experiment.virtual import Apparatus
 from stickslip.experiment.virtual.rate_state import RateStateLaw
@@ -108,13 +109,7 @@ def test_the_analytic_jacobian_includes_the_slope_and_curvature_along_the_path()
     without = SlabDynamics(dynamics.apparatus, LAW, 0.143, 5.0)
     for state in states:
         J = dynamics.jacobian(state, rate)
-        numeric = np.empty_like(J)
-        for j in range(state.size):
-            step = 1e-7 if j < 3 else (1e-9 if j < 6 else 1e-6 * max(abs(state[j]), 1e-3))
-            up, down = state.copy(), state.copy()
-            up[j] += step
-            down[j] -= step
-            numeric[:, j] = (dynamics.rhs(up, rate) - dynamics.rhs(down, rate)) / (2 * step)
+        numeric = central_differences(dynamics, state, rate)
         scale = np.abs(J).max(axis=0)
         assert np.all(np.abs(J - numeric) <= 1e-6 * scale + 1e-12)
         assert np.abs(J[:, :3] - without.jacobian(state, rate)[:, :3]).max() > 0.0

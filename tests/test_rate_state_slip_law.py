@@ -15,6 +15,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from jacobian_check import central_differences
 from stickslip import registry
 from stickslip.experiment.timeseries import read_truth
 from stickslip.experiment.virtual import Apparatus
@@ -45,13 +46,7 @@ def test_the_slip_laws_analytic_jacobian_equals_central_differences():
     assert rates.max() > 1.0 and rates.min() < 1e-4  # sticks and slips
     for state in states:
         J = dynamics.jacobian(state, rate)
-        numeric = np.empty_like(J)
-        for j in range(state.size):
-            step = 1e-7 if j < 3 else (1e-9 if j < 6 else 1e-6 * max(abs(state[j]), 1e-3))
-            up, down = state.copy(), state.copy()
-            up[j] += step
-            down[j] -= step
-            numeric[:, j] = (dynamics.rhs(up, rate) - dynamics.rhs(down, rate)) / (2 * step)
+        numeric = central_differences(dynamics, state, rate)
         assert np.all(np.abs(J - numeric) <= 1e-6 * np.abs(J).max(axis=0) + 1e-12)
 
 
