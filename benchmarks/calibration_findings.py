@@ -21,9 +21,12 @@ them: the root mean square of the seeds' own errors over ``sqrt(k)``):
 4. the post-slip stress against ln T of the slips after a reload (the paper assumes it constant); the aging-off
    control's bend;
 5. the true B per interface in the n = 2 stacks;
-6. pooling: the pooled and per-interface fits of interfaces of different strength (fem, twin, synthetic slips with
-   the paper's strengths and loading rates), beside the paper's 0.053 +- 0.005;
-7. the estimator beside the paper's (:mod:`stickslip.statistics.loading_contrast`) against the truth: fem and twin;
+6. pooling: the pooled and per-interface fits of interfaces of different strength (fem, twin with the aging and
+   the slip law, synthetic slips with the paper's strengths and loading rates), beside the paper's 0.053 +- 0.005;
+7. the estimator beside the paper's (:mod:`stickslip.statistics.loading_contrast`) against the truth, fem and twin,
+   with the slips per path it would need at the reach measured; 7b. what (dmu_a, T_a) can tell at all: an aging
+   interface's drops against its aging-free control's drop law at equal T (:mod:`stickslip.statistics.drop_law`), and
+   the paper's estimator on the aging interface's waiting times with the control's drops;
 8. the pre-check of the decisive drive: std ln T_a per interface, its robust spread, the share of the loading that
    other slips take, against the criteria, per N, Phi and n; the go/no-go;
 9. the cost: CPU seconds of every simulation and the wall time of the events jobs, per study;
@@ -45,11 +48,14 @@ import pandas as pd
 import yaml
 
 from stickslip.experiment.timeseries import read_truth
+from stickslip.experiment.virtual.rate_state import RateStateLaw
+from stickslip.experiment.virtual.slide_hold_slide import hold_healing
 from stickslip.figures.experimental_data import load_slips
 from stickslip.statistics.calibration import (LAB_MEAN_LN, LAB_RESOLUTION, calibration_line, lab_clock, log_spread,
                                               merge_unresolved, over_seeds)
+from stickslip.statistics.drop_law import at_equal_T, drop_law_contrast
 from stickslip.statistics.estimator import estimate, lab_slips
-from stickslip.statistics.loading_contrast import loading_contrast
+from stickslip.statistics.loading_contrast import loading_contrast, slips_needed
 from stickslip.summaries.aging_summary import curvature, first_peaks, ratio
 from stickslip.summaries.calibration_summary import load_calibration_runs, post_slip_slope, run_slips, run_truth
 from stickslip.summaries.dissonance_summary import loading_rates, peak_ages
@@ -328,26 +334,38 @@ def twin_slips(studies):
         return pd.DataFrame()
     slips = load_slips(paths)
     slips = slips[slips["protocol"] == "stack"].copy()
-    b_of, a_of, pair = {}, {}, {}
+    b_of, a_of, D_c_of, pair, law = {}, {}, {}, {}, {}
     for path in paths:
         study = Path(path).parents[3]
         truth = read_truth(study / "sim" / "rate-state-lever" / Path(path).name, "interfaces")
         b_of[path], a_of[path] = dict(zip(truth["a"], truth["b"])), dict(zip(truth["a"], truth["a_rs"]))
+        D_c_of[path] = dict(zip(truth["a"], truth["D_c"]))
         with h5py.File(path, "r") as file:
             params = json.loads(file.attrs["params"])
         pair[path] = (tuple(params.get("rs_a", ())), tuple(params.get("rs_b", ())))
-    slips["b"] = [b_of[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
-    slips["a_rs"] = [a_of[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
+        law[path] = params.get("rs_state_law", "aging")
+    for column, values in (("b", b_of), ("a_rs", a_of), ("D_c", D_c_of)):
+        slips[column] = [values[f].get(a, np.nan) for f, a in zip(slips["file"], slips["interface"])]
     slips["pair"] = [pair[f] for f in slips["file"]]
+    slips["law"] = [law[f] for f in slips["file"]]
     return slips
+
+
+def twin_healing(single, law):
+    """The hold healing per e-fold (slide-hold-slide at a stiff drive) of the slips' mean interface under ``law``."""
+    values = {name: np.full(5, float(single[column].mean())) for name, column in (("a", "a_rs"), ("b", "b"),
+                                                                                    ("D_c", "D_c"))}
+    return hold_healing(RateStateLaw(**values, mu0=np.full(5, 0.35), V0=1e-3, state_law=law))["rate"]
 
 
 def twin_summary(slips):
     if slips.empty:
         return
-    print("\n## 6b. Pooling in the rate-and-state twin (B = b by construction; T0 = 1 s): per (rs_a, rs_b) and seed, "
-          "the pooled fits over interfaces and n, the per-interface fits (mean over interfaces), the loading contrast")
-    for pair_, group in slips.groupby("pair"):
+    print("\n## 6b. Pooling in the rate-and-state twin (aging law: B = b by construction; slip law: no healing at "
+          "rest, the aging-off control; T0 = 1 s): per (rs_a, rs_b, state law) and seed, the pooled fits over "
+          "interfaces and n, the per-interface fits (mean over interfaces), the loading contrast; the mean interface's "
+          "healing per e-fold of a hold (slide-hold-slide, spring 100 K_c, 10-1000 s)")
+    for (pair_, law), group in slips.groupby(["pair", "law"]):
         rows = []
         for seed, mine in group.groupby("seed"):
             single = mine[~mine["multi"].to_numpy(dtype=bool)]
@@ -361,8 +379,10 @@ def twin_summary(slips):
             rows.append(row)
         rows = pd.DataFrame(rows)
         drops = group[~group["multi"] & (group["n"] == group["interface"])].groupby("interface")["dmu"].mean()
-        print(f"- rs_a {list(pair_[0]) or 'default'}, rs_b {list(pair_[1]) or 'default'}: {group['file'].nunique()} "
-              f"runs, {len(group)} slips; mean drop of interface a in the stack n = a: "
+        healing = twin_healing(group, law)
+        print(f"- rs_a {list(pair_[0]) or 'default'}, rs_b {list(pair_[1]) or 'default'}, {law} law: "
+              f"{group['file'].nunique()} runs, {len(group)} slips; hold healing {healing:.4f} per e-fold "
+              f"({healing / group['b'].mean():.2f} b); mean drop of interface a in the stack n = a: "
               + ", ".join(f"{d:.3f}" for d in drops))
         for column in rows:
             if column != "seed":
@@ -409,12 +429,61 @@ def contrast_fem_summary(slips, truth):
         result = loading_contrast(mine[mine["interface"] == 1], t0=t0)
         t = truth[(truth["strengthening"] == lam) & (truth["seed"] == seed) & (truth["n"] == 1)]
         true = float(t["B"].iloc[0]) if len(t) else math.nan
+        single = mine[(mine["interface"] == 1) & ~mine["multi"].to_numpy(dtype=bool)]
+        needed = slips_needed(float(single.groupby("n")["dmu"].std().mean()), true, result["lnT_range"])
         print(f"- lambda {lam:g}, seed {seed}: B = {fmt(result['B'], result['B_error'])} (<ln T> apart by "
-              f"{result['lnT_range']:.2f}); true {true:.4f}")
+              f"{result['lnT_range']:.2f}); true {true:.4f}; slips per path for 25 % at this reach {needed:.3g} "
+              f"(here {result['slips'] // 2})")
         rows.append({"lambda": lam, "B": result["B"], "error": result["B_error"], "true": true})
     for lam, part in pd.DataFrame(rows).groupby("lambda") if rows else []:
         est, tr = over_seeds(part["B"], part["error"]), over_seeds(part["true"])
         print(f"  over seeds, lambda {lam:g}: {seeds_line(est)}; true {seeds_line(tr)}")
+
+
+def drop_law_summary(runs, truth, clocks):
+    """Section 7b: at equal waiting time, do an interface's drops carry its aging (n = 1, same seed)?"""
+    slips = run_slips(runs[runs["thermal"] & (runs["n"] == 1) & np.isclose(runs["phi"], PHI, rtol=0.05, atol=0.0)
+                           & (runs["N"] == 162)])
+    control = slips[(slips["strengthening"] == 0.0) & (slips["strength"] == 1.0)]
+    if control.empty or slips["strengthening"].nunique() < 2:
+        return
+    print("\n## 7b. What (dmu_a, T_a) can tell: an interface's drops against its aging-free control's drop law at "
+          "equal T (n = 1, same seed; single slips; stickslip.statistics.drop_law, bins of half an e-fold, bootstrap "
+          "errors); the slope is the aging the drops show at equal T, beside the difference of the true B. The "
+          "paper's estimator (origin fit) on the record and on its waiting times with the control's drop law "
+          "(at_equal_T): model clock raw, and as the lab reads it (its eye and clock)")
+    true = truth[truth["n"] == 1].set_index(["strengthening", "seed", "strength"])["B"]
+    rows = []
+    for (lam, strength, seed), mine in slips.groupby(["strengthening", "strength", "seed"]):
+        reference = control[control["seed"] == seed]
+        if (lam, strength) == (0.0, 1.0) or reference.empty or lam not in clocks:
+            continue
+        t0, t0_lab = float(mine["T0"].iloc[0]), clocks[lam][0]
+        row = {"lambda": lam, "strength": strength, "seed": seed,
+               "true - control": true.get((lam, seed, strength), math.nan) - true.get((0.0, seed, 1.0), math.nan)}
+        for which in EYES:
+            seen, ref = (eye(part, t0_lab, which) for part in (mine, reference))
+            seen, ref = (part[~part["multi"].to_numpy(dtype=bool)] for part in (seen, ref))
+            contrast = drop_law_contrast(seen["T"], seen["dmu"], ref["T"], ref["dmu"], t0=t0)
+            swapped = at_equal_T(seen["T"], ref["T"], ref["dmu"], t0=t0, rng=np.random.default_rng(seed))
+            clock = t0 if which == "raw" else t0_lab
+            row |= {f"{which} slope": contrast["slope"], f"{which} slope error": contrast["slope_error"],
+                    f"{which} offset": contrast["offset"], f"{which} share": contrast["share"],
+                    f"{which} estimate": estimate(seen["T"], seen["dmu"], t0=clock, fit="origin")["B"],
+                    f"{which} estimate at equal T": estimate(*swapped, t0=clock, fit="origin")["B"]}
+            print(f"- lambda {lam:g}, strength {strength:g}, seed {seed}, {which}: slope at equal T "
+                  f"{fmt(contrast['slope'], contrast['slope_error'])}, offset "
+                  f"{fmt(contrast['offset'], contrast['offset_error'])} ({contrast['slips']} slips, {contrast['share']:.2f} of them, ln T/T0 "
+                  f"{contrast['lnT_low']:.1f}-{contrast['lnT_high']:.1f}); true B - control's "
+                  f"{row['true - control']:.4f}; estimate {row[f'{which} estimate']:.4f}, with the control's drops at "
+                  f"its T {row[f'{which} estimate at equal T']:.4f}" + (f" ({contrast['reason']})"
+                                                                        if contrast["reason"] else ""))
+        rows.append(row)
+    print("- over seeds:")
+    for (lam, strength), part in pd.DataFrame(rows).groupby(["lambda", "strength"]):
+        print(f"  lambda {lam:g}, strength {strength:g}: " + "; ".join(
+            f"{k} {seeds_line(over_seeds(part[k], part.get(k + ' error')))}" for k in part
+            if k not in ("lambda", "strength", "seed") and not k.endswith("error")))
 
 
 # --- 8. the pre-check ----------------------------------------------------------------------------------------------
@@ -614,6 +683,7 @@ def main(argv=None):
         post_slip_summary(alone)
         stack_truth_summary(cal_truth)
         contrast_fem_summary(slips, cal_truth)
+        drop_law_summary(runs, truth, clocks)
     if not runs.empty:
         pooling_fem_summary(runs, truth)
     twin_summary(twin_slips(args.studies))
