@@ -444,46 +444,56 @@ def drop_law_summary(runs, truth, clocks):
     """Section 7b: at equal waiting time, do an interface's drops carry its aging (n = 1, same seed)?"""
     slips = run_slips(runs[runs["thermal"] & (runs["n"] == 1) & np.isclose(runs["phi"], PHI, rtol=0.05, atol=0.0)
                            & (runs["N"] == 162)])
-    control = slips[(slips["strengthening"] == 0.0) & (slips["strength"] == 1.0)]
-    if control.empty or slips["strengthening"].nunique() < 2:
+    controls = slips[slips["strengthening"] == 0.0]
+    if controls.empty or slips["strengthening"].nunique() < 2:
         return
-    print("\n## 7b. What (dmu_a, T_a) can tell: an interface's drops against its aging-free control's drop law at "
+    print("\n## 7b. What (dmu_a, T_a) can tell: an interface's drops against an aging-free interface's drop law at "
           "equal T (n = 1, same seed; single slips; stickslip.statistics.drop_law, bins of half an e-fold, bootstrap "
-          "errors); the slope is the aging the drops show at equal T, beside the difference of the true B. The "
-          "paper's estimator (origin fit) on the record and on its waiting times with the control's drop law "
-          "(at_equal_T): model clock raw, and as the lab reads it (its eye and clock)")
+          "errors): the offset and slope at equal T beside the difference of the true B. The paper's estimator "
+          "(origin fit) on the record and on its waiting times with the reference's drop law (at_equal_T): model "
+          "clock raw, and as the lab reads it (its eye and clock)")
     true = truth[truth["n"] == 1].set_index(["strengthening", "seed", "strength"])["B"]
     rows = []
     for (lam, strength, seed), mine in slips.groupby(["strengthening", "strength", "seed"]):
-        reference = control[control["seed"] == seed]
-        if (lam, strength) == (0.0, 1.0) or reference.empty or lam not in clocks:
-            continue
-        t0, t0_lab = float(mine["T0"].iloc[0]), clocks[lam][0]
-        row = {"lambda": lam, "strength": strength, "seed": seed,
-               "true - control": true.get((lam, seed, strength), math.nan) - true.get((0.0, seed, 1.0), math.nan)}
-        for which in EYES:
-            seen, ref = (eye(part, t0_lab, which) for part in (mine, reference))
-            seen, ref = (part[~part["multi"].to_numpy(dtype=bool)] for part in (seen, ref))
-            contrast = drop_law_contrast(seen["T"], seen["dmu"], ref["T"], ref["dmu"], t0=t0)
-            swapped = at_equal_T(seen["T"], ref["T"], ref["dmu"], t0=t0, rng=np.random.default_rng(seed))
-            clock = t0 if which == "raw" else t0_lab
-            row |= {f"{which} slope": contrast["slope"], f"{which} slope error": contrast["slope_error"],
-                    f"{which} offset": contrast["offset"], f"{which} share": contrast["share"],
-                    f"{which} estimate": estimate(seen["T"], seen["dmu"], t0=clock, fit="origin")["B"],
-                    f"{which} estimate at equal T": estimate(*swapped, t0=clock, fit="origin")["B"]}
-            print(f"- lambda {lam:g}, strength {strength:g}, seed {seed}, {which}: slope at equal T "
-                  f"{fmt(contrast['slope'], contrast['slope_error'])}, offset "
-                  f"{fmt(contrast['offset'], contrast['offset_error'])} ({contrast['slips']} slips, {contrast['share']:.2f} of them, ln T/T0 "
-                  f"{contrast['lnT_low']:.1f}-{contrast['lnT_high']:.1f}); true B - control's "
-                  f"{row['true - control']:.4f}; estimate {row[f'{which} estimate']:.4f}, with the control's drops at "
-                  f"its T {row[f'{which} estimate at equal T']:.4f}" + (f" ({contrast['reason']})"
-                                                                        if contrast["reason"] else ""))
-        rows.append(row)
+        for reference_strength, reference in controls[controls["seed"] == seed].groupby("strength"):
+            if (lam, strength) == (0.0, reference_strength) or lam not in clocks:
+                continue
+            row = {"lambda": lam, "strength": strength, "reference": reference_strength, "seed": seed,
+                   "true - reference": true.get((lam, seed, strength), math.nan)
+                   - true.get((0.0, seed, reference_strength), math.nan)}
+            row |= _drop_law_row(mine, reference, clocks[lam][0], row)
+            rows.append(row)
     print("- over seeds:")
-    for (lam, strength), part in pd.DataFrame(rows).groupby(["lambda", "strength"]):
-        print(f"  lambda {lam:g}, strength {strength:g}: " + "; ".join(
+    for (lam, strength, reference), part in pd.DataFrame(rows).groupby(["lambda", "strength", "reference"]):
+        print(f"  lambda {lam:g}, strength {strength:g} against the aging-free strength {reference:g}: " + "; ".join(
             f"{k} {seeds_line(over_seeds(part[k], part.get(k + ' error')))}" for k in part
-            if k not in ("lambda", "strength", "seed") and not k.endswith("error")))
+            if k not in ("lambda", "strength", "reference", "seed") and not k.endswith("error")))
+
+
+def _drop_law_row(mine, reference, t0_lab, row):
+    """The drop-law contrast and the estimates of one record against one reference, raw and as the lab sees them."""
+    t0 = float(mine["T0"].iloc[0])
+    out = {}
+    for which in EYES:
+        seen, ref = (eye(part, t0_lab, which) for part in (mine, reference))
+        seen, ref = (part[~part["multi"].to_numpy(dtype=bool)] for part in (seen, ref))
+        contrast = drop_law_contrast(seen["T"], seen["dmu"], ref["T"], ref["dmu"], t0=t0)
+        swapped = at_equal_T(seen["T"], ref["T"], ref["dmu"], t0=t0, rng=np.random.default_rng(int(row["seed"])))
+        clock = t0 if which == "raw" else t0_lab
+        out |= {f"{which} slope": contrast["slope"], f"{which} slope error": contrast["slope_error"],
+                f"{which} offset": contrast["offset"], f"{which} offset error": contrast["offset_error"],
+                f"{which} share": contrast["share"],
+                f"{which} estimate": estimate(seen["T"], seen["dmu"], t0=clock, fit="origin")["B"],
+                f"{which} estimate at equal T": estimate(*swapped, t0=clock, fit="origin")["B"]}
+        print(f"- lambda {row['lambda']:g}, strength {row['strength']:g} against the aging-free strength "
+              f"{row['reference']:g}, seed {row['seed']}, {which}: slope at equal T "
+              f"{fmt(contrast['slope'], contrast['slope_error'])}, offset "
+              f"{fmt(contrast['offset'], contrast['offset_error'])} ({contrast['slips']} slips, "
+              f"{contrast['share']:.2f} of them, ln T/T0 {contrast['lnT_low']:.1f}-{contrast['lnT_high']:.1f}); true B "
+              f"- reference's {row['true - reference']:.4f}; estimate {out[f'{which} estimate']:.4f}, with the "
+              f"reference's drops at its T {out[f'{which} estimate at equal T']:.4f}"
+              + (f" ({contrast['reason']})" if contrast["reason"] else ""))
+    return out
 
 
 # --- 8. the pre-check ----------------------------------------------------------------------------------------------

@@ -3,13 +3,16 @@
 A record is an interface's single slips, pairs ``(dmu_a, T_a)``. Aging raises the threshold that an interface
 reaches after a wait. In a record it can only show where it changes the drop *at a given waiting time*: the
 conditional law ``E[dmu | T]``, the drop law. Where the interface is reloaded by a drive whose rate the threshold
-does not set (a constant drive, an interface driven alone), the stress it regains in a wait ``T`` is the drive's,
-whatever its threshold, and the drop is what it regained (give or take the change of the post-slip stress): the
-drop at a given ``T`` is the reload's, with or without aging. Aging then moves the slips *along* the drop law
-(a stronger threshold takes longer to reach) and so does a disorder of the thresholds without aging: the two make
+does not set (a constant drive, an interface driven alone) and does not creep, the stress it regains in a wait ``T``
+is the drive's, whatever its threshold, and the drop is what it regained (give or take the change of the post-slip
+stress): the drop at a given ``T`` is the reload's, with or without aging. Aging then moves the slips *along* the drop
+law (a stronger threshold takes longer to reach) and so does a disorder of the thresholds without aging: the two make
 the same records, and no function of ``(dmu_a, T_a)`` can tell them apart. Identifying aging needs a variation of
 ``T`` that the threshold does not make: a hold, or another loading path of the same surfaces
-(:mod:`.loading_contrast`).
+(:mod:`.loading_contrast`). Where the interface creeps in the wait (thermal activation), the creep relaxes part of
+the reload, and whatever slows the creep (aging, but also stronger thresholds without aging) raises the drop at a
+given ``T``: the drop law then differs, and the question is whether an aging-free interface of another strength
+differs in the same way (docs/numerical-analysis.md, "The calibration").
 
 This module measures that on records:
 
