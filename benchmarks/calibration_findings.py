@@ -46,6 +46,7 @@ import h5py
 import numpy as np
 import pandas as pd
 import yaml
+from scipy import stats
 
 from stickslip.experiment.timeseries import read_truth
 from stickslip.experiment.virtual.rate_state import RateStateLaw
@@ -393,6 +394,48 @@ def twin_summary(slips):
                 print(line)
 
 
+def twin_match_summary(slips):
+    """Section 6d: each slip-law setting against the aging-law setting of the same direct effects (rs_a)."""
+    laws = dict(list(slips.groupby("law"))) if not slips.empty else {}
+    if "slip" not in laws or "aging" not in laws:
+        return
+    print("\n## 6d. The twin's records with and without healing at rest: each slip-law setting against the aging-law "
+          "setting of the same rs_a (seeds both have): per (interface, n) the ratio of the mean drops and the shift of "
+          "the mean ln T (slip - aging), two-sample Kolmogorov-Smirnov p of the drops and of ln T (all single slips), "
+          "the estimators (T0 = 1 s; means over the seeds' fits, as 6b) and the hold healing of both")
+    for (pair_, _), slip in laws["slip"].groupby(["pair", "law"]):
+        aging = laws["aging"][laws["aging"]["pair"].apply(lambda p: p[0] == pair_[0])]
+        for aging_pair, reference in aging.groupby("pair"):
+            seeds = sorted(set(slip["seed"]) & set(reference["seed"]))
+            mine, theirs = (d[d["seed"].isin(seeds) & ~d["multi"].to_numpy(dtype=bool)] for d in (slip, reference))
+            means = [d.assign(lnT=np.log(d["T"])).groupby(["interface", "n"])[["dmu", "lnT"]].mean()
+                     for d in (mine, theirs)]
+            joined = means[0].join(means[1], rsuffix="_aging", how="inner")
+            ratio_, shift = joined["dmu"] / joined["dmu_aging"], joined["lnT"] - joined["lnT_aging"]
+            logs = [np.log(d["T"].to_numpy(dtype=float)) for d in (mine, theirs)]
+            logs = [x[np.isfinite(x)] for x in logs]
+            readings = [np.nanmean([_twin_readings(d[d["seed"] == seed]) for seed in seeds], axis=0)
+                        for d in (slip, reference)]
+            names = ("pooled origin", "pooled intercept", "per-interface intercept", "contrast")
+            print(f"- slip law rs_b {list(pair_[1]) or 'default'} (b {mine['b'].mean():.4f}, hold healing "
+                  f"{twin_healing(mine, 'slip'):.4f}) against the aging law rs_b {list(aging_pair[1])} (b "
+                  f"{theirs['b'].mean():.4f}, hold healing {twin_healing(theirs, 'aging'):.4f}), rs_a "
+                  f"{list(pair_[0])}, seeds {seeds}: drop ratio {ratio_.min():.2f}-{ratio_.max():.2f} (mean "
+                  f"{ratio_.mean():.2f}), ln T shift {shift.min():.2f}-{shift.max():.2f} over {len(joined)} groups; KS "
+                  f"p drops {stats.ks_2samp(mine['dmu'], theirs['dmu']).pvalue:.2g}, ln T "
+                  f"{stats.ks_2samp(*logs).pvalue:.2g} ({len(mine)}, {len(theirs)} slips); "
+                  + "; ".join(f"{name} {r[0]:.4f} / {r[1]:.4f}" for name, r in zip(names, zip(*readings))))
+
+
+def _twin_readings(slips):
+    """The paper's pooled fits, the per-interface free intercept (mean over interfaces) and the loading contrast."""
+    single = slips[~slips["multi"].to_numpy(dtype=bool)]
+    return ([estimate(single["T"], single["dmu"], t0=1.0, fit=fit)["B"] for fit in FITS]
+            + [float(np.nanmean([estimate(p["T"], p["dmu"], t0=1.0, fit="intercept")["B"]
+                                 for _, p in single.groupby("interface")])),
+               loading_contrast(slips, t0=1.0)["B"]])
+
+
 def synthetic_pooling_summary():
     print("\n## 6c. Pooling on synthetic slips (stickslip.statistics.estimator.lab_slips): the paper's strengths "
           "0.15-0.3 (5 interfaces), its loading rates (n + a)(n - a + 1) / 2, n = 1 ... 5 (15 groups), thresholds' "
@@ -696,8 +739,10 @@ def main(argv=None):
         drop_law_summary(runs, truth, clocks)
     if not runs.empty:
         pooling_fem_summary(runs, truth)
-    twin_summary(twin_slips(args.studies))
+    twins = twin_slips(args.studies)
+    twin_summary(twins)
     synthetic_pooling_summary()
+    twin_match_summary(twins)
     if not runs.empty:
         precheck_summary(runs, args.studies)
     cost_summary(args.studies, runs)
