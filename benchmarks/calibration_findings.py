@@ -421,10 +421,18 @@ def twin_match_summary(slips):
                   f"{twin_healing(mine, 'slip'):.4f}) against the aging law rs_b {list(aging_pair[1])} (b "
                   f"{theirs['b'].mean():.4f}, hold healing {twin_healing(theirs, 'aging'):.4f}), rs_a "
                   f"{list(pair_[0])}, seeds {seeds}: drop ratio {ratio_.min():.2f}-{ratio_.max():.2f} (mean "
-                  f"{ratio_.mean():.2f}), ln T shift {shift.min():.2f}-{shift.max():.2f} over {len(joined)} groups; KS "
-                  f"p drops {stats.ks_2samp(mine['dmu'], theirs['dmu']).pvalue:.2g}, ln T "
-                  f"{stats.ks_2samp(*logs).pvalue:.2g} ({len(mine)}, {len(theirs)} slips); "
+                  f"{ratio_.mean():.2f}), ln T shift {shift.min():.2f}-{shift.max():.2f} over {len(joined)} groups; "
+                  f"{_ks_line('drops', mine['dmu'], theirs['dmu'])}, {_ks_line('ln T', *logs)} ({len(mine)}, "
+                  f"{len(theirs)} slips); "
                   + "; ".join(f"{name} {r[0]:.4f} / {r[1]:.4f}" for name, r in zip(names, zip(*readings))))
+
+
+def _ks_line(name, first, second):
+    """Two-sample Kolmogorov-Smirnov D and p, and the slips per record at which that D would be significant at 5 %
+    (equal records: ``2 (1.358 / D)^2``)."""
+    result = stats.ks_2samp(first, second)
+    return (f"KS {name} D {result.statistic:.3f}, p {result.pvalue:.2g} (told apart at 5 % from "
+            f"{2 * (1.358 / result.statistic) ** 2:.0f} slips per record)")
 
 
 def _twin_readings(slips):
