@@ -23,6 +23,7 @@ them: the root mean square of the seeds' own errors over ``sqrt(k)``):
 5. the true B per interface in the n = 2 stacks;
 6. pooling: the pooled and per-interface fits of interfaces of different strength (fem, twin with the aging and
    the slip law, synthetic slips with the paper's strengths and loading rates), beside the paper's 0.053 +- 0.005;
+   6d. the twin's records with and without healing at rest compared (drops, ln T, KS, the estimators);
 7. the estimator beside the paper's (:mod:`stickslip.statistics.loading_contrast`) against the truth, fem and twin,
    with the slips per path it would need at the reach measured; 7b. what (dmu_a, T_a) can tell at all: an aging
    interface's drops against its aging-free control's drop law at equal T (:mod:`stickslip.statistics.drop_law`), and
