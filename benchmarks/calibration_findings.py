@@ -283,7 +283,7 @@ def fits_line(slips, t0, label):
     return out
 
 
-def pooling_fem_summary(runs, truth):
+def pooling_fem_summary(runs, truth, clocks):
     slips = run_slips(runs[runs["thermal"] & np.isclose(runs["phi"], PHI, rtol=0.05, atol=0.0) & (runs["N"] == 162)])
     slips = slips.assign(group=slips["strength"].astype(str) + "/" + slips["n"].astype(str))
     strong = slips["run"].isin(slips.loc[slips["strength"] == 2.0, "run"])
@@ -291,7 +291,8 @@ def pooling_fem_summary(runs, truth):
     if partners.empty:
         return
     print("\n## 6a. Pooling in the fem model: interfaces of strength 1 and 2 (alone, n = 1, and stacked, weak under "
-          "strong, n = 2), lambda 0 and 5, per seed; fits on T0 = 1 / nu")
+          "strong, n = 2), lambda 0 and 5, per seed; fits on T0 = 1 / nu, raw, and as the lab reads them ('lab': its eye "
+          "and clock of the lambda, section 2)")
     table = []
     for (lam, seed), mine in partners.groupby(["strengthening", "seed"]):
         t0 = float(mine["T0"].iloc[0])
@@ -301,6 +302,14 @@ def pooling_fem_summary(runs, truth):
             row[f"pooled {fit}"] = estimate(single["T"], single["dmu"], t0=t0, fit=fit)["B"]
             for s, part in single.groupby("strength"):
                 row[f"strength {s:g} {fit}"] = estimate(part["T"], part["dmu"], t0=t0, fit=fit)["B"]
+        if lam in clocks:
+            t0_lab = clocks[lam][0]
+            seen = eye(mine, t0_lab, "lab")
+            seen = seen[~seen["multi"].to_numpy(dtype=bool)]
+            for fit in FITS:
+                row[f"lab pooled {fit}"] = estimate(seen["T"], seen["dmu"], t0=t0_lab, fit=fit)["B"]
+                for s, part in seen.groupby("strength"):
+                    row[f"lab strength {s:g} {fit}"] = estimate(part["T"], part["dmu"], t0=t0_lab, fit=fit)["B"]
         contrast = loading_contrast(mine, t0=t0, interface="strength")
         row["contrast"], row["contrast error"] = contrast["B"], contrast["B_error"]
         for s in (1.0, 2.0):
@@ -311,7 +320,7 @@ def pooling_fem_summary(runs, truth):
         print(f"- lambda {lam:g}, seed {seed}: " + "; ".join(f"{k} {v:.4f}" for k, v in row.items()
                                                               if k not in ("lambda", "seed"))
               + "; per group (strength/n) mean drop, <ln T/T0>: " + ", ".join(
-                  f"{g} {p['dmu'].mean():.3f}, {np.log(p['T'] / t0).mean():.1f} ({len(p)})" for g, p in groups))
+                  f"{g} {p['dmu'].mean():.3f}, {_mean_log(p['T'] / t0):.1f} ({len(p)})" for g, p in groups))
         table.append(row)
     table = pd.DataFrame(table)
     print("- over seeds:")
@@ -747,7 +756,7 @@ def main(argv=None):
         contrast_fem_summary(slips, cal_truth)
         drop_law_summary(runs, truth, clocks)
     if not runs.empty:
-        pooling_fem_summary(runs, truth)
+        pooling_fem_summary(runs, truth, clocks if not calibration.empty else {})
     twins = twin_slips(args.studies)
     twin_summary(twins)
     synthetic_pooling_summary()
