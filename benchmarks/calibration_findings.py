@@ -316,6 +316,9 @@ def pooling_fem_summary(runs, truth, clocks):
             t = truth[(truth["strengthening"] == lam) & (truth["seed"] == seed) & (truth["n"] == 1)
                       & (truth["strength"] == s)]
             row[f"true {s:g}"] = float(t["B"].iloc[0]) if len(t) else math.nan
+        row["contrast reach"] = contrast["lnT_range"]
+        row["slips per path for 25 %"] = slips_needed(float(single.groupby("group")["dmu"].std().mean()),
+                                                      row["true 1"], contrast["lnT_range"])
         groups = single.groupby("group")
         print(f"- lambda {lam:g}, seed {seed}: " + "; ".join(f"{k} {v:.4f}" for k, v in row.items()
                                                               if k not in ("lambda", "seed"))
