@@ -383,14 +383,8 @@ def twin_summary(slips):
         rows = []
         for seed, mine in group.groupby("seed"):
             single = mine[~mine["multi"].to_numpy(dtype=bool)]
-            row = {"seed": seed, "b": float(single["b"].mean())}
-            for fit in FITS:
-                row[f"pooled {fit}"] = estimate(single["T"], single["dmu"], t0=1.0, fit=fit)["B"]
-                per = [estimate(p["T"], p["dmu"], t0=1.0, fit=fit)["B"] for _, p in single.groupby("interface")]
-                row[f"per-interface {fit}"] = float(np.nanmean(per))
-            contrast = loading_contrast(mine, t0=1.0)
-            row["contrast"], row["b - a"] = contrast["B"], float((single["b"] - single["a_rs"]).mean())
-            rows.append(row)
+            rows.append({"seed": seed, "b": float(single["b"].mean())} | _twin_readings(mine)
+                        | {"b - a": float((single["b"] - single["a_rs"]).mean())})
         rows = pd.DataFrame(rows)
         drops = group[~group["multi"] & (group["n"] == group["interface"])].groupby("interface")["dmu"].mean()
         healing = twin_healing(group, law)
@@ -416,7 +410,7 @@ def twin_match_summary(slips):
           "setting of the same rs_a (seeds both have): per (interface, n) the ratio of the mean drops and the shift of "
           "the mean ln T (slip - aging), two-sample Kolmogorov-Smirnov p of the drops and of ln T (all single slips), "
           "the estimators (T0 = 1 s; means over the seeds' fits, as 6b) and the hold healing of both")
-    for (pair_, _), slip in laws["slip"].groupby(["pair", "law"]):
+    for pair_, slip in laws["slip"].groupby("pair"):
         aging = laws["aging"][laws["aging"]["pair"].apply(lambda p: p[0] == pair_[0])]
         for aging_pair, reference in aging.groupby("pair"):
             seeds = sorted(set(slip["seed"]) & set(reference["seed"]))
@@ -427,7 +421,7 @@ def twin_match_summary(slips):
             ratio_, shift = joined["dmu"] / joined["dmu_aging"], joined["lnT"] - joined["lnT_aging"]
             logs = [np.log(d["T"].to_numpy(dtype=float)) for d in (mine, theirs)]
             logs = [x[np.isfinite(x)] for x in logs]
-            readings = [np.nanmean([_twin_readings(d[d["seed"] == seed]) for seed in seeds], axis=0)
+            readings = [pd.DataFrame([_twin_readings(d[d["seed"] == seed]) for seed in seeds]).mean()
                         for d in (slip, reference)]
             names = ("pooled origin", "pooled intercept", "per-interface intercept", "contrast")
             print(f"- slip law rs_b {list(pair_[1]) or 'default'} (b {mine['b'].mean():.4f}, hold healing "
@@ -437,7 +431,7 @@ def twin_match_summary(slips):
                   f"{ratio_.mean():.2f}), ln T shift {shift.min():.2f}-{shift.max():.2f} over {len(joined)} groups; "
                   f"{_ks_line('drops', mine['dmu'], theirs['dmu'])}, {_ks_line('ln T', *logs)} ({len(mine)}, "
                   f"{len(theirs)} slips); "
-                  + "; ".join(f"{name} {r[0]:.4f} / {r[1]:.4f}" for name, r in zip(names, zip(*readings))))
+                  + "; ".join(f"{name} {readings[0][name]:.4f} / {readings[1][name]:.4f}" for name in names))
 
 
 def _ks_line(name, first, second):
@@ -449,12 +443,14 @@ def _ks_line(name, first, second):
 
 
 def _twin_readings(slips):
-    """The paper's pooled fits, the per-interface free intercept (mean over interfaces) and the loading contrast."""
+    """One seed's readings: the paper's fits pooled and per interface (mean over interfaces), the loading contrast."""
     single = slips[~slips["multi"].to_numpy(dtype=bool)]
-    return ([estimate(single["T"], single["dmu"], t0=1.0, fit=fit)["B"] for fit in FITS]
-            + [float(np.nanmean([estimate(p["T"], p["dmu"], t0=1.0, fit="intercept")["B"]
-                                 for _, p in single.groupby("interface")])),
-               loading_contrast(slips, t0=1.0)["B"]])
+    row = {}
+    for fit in FITS:
+        row[f"pooled {fit}"] = estimate(single["T"], single["dmu"], t0=1.0, fit=fit)["B"]
+        row[f"per-interface {fit}"] = float(np.nanmean([estimate(p["T"], p["dmu"], t0=1.0, fit=fit)["B"]
+                                                        for _, p in single.groupby("interface")]))
+    return row | {"contrast": loading_contrast(slips, t0=1.0)["B"]}
 
 
 def synthetic_pooling_summary():
