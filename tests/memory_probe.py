@@ -33,6 +33,7 @@ def measure(N, plates, directory, max_increments=1, preexec_fn=None):
     """
     values = {"N": str(N), "plates": str(plates), "max_increments": str(max_increments)}
     output = Path(directory) / f"memory-{N}-{plates}.h5"
+    output.unlink(missing_ok=True)  # a run file already there would be resumed, not built: no model, no peak
     done = subprocess.run([sys.executable, "-c", CHILD, json.dumps(values), str(output)], capture_output=True,
                           text=True, check=True, preexec_fn=preexec_fn)
     return json.loads(done.stdout.splitlines()[-1])
