@@ -11,7 +11,7 @@ held, and the plates' stiffness is assembled from the element arrays (:func:`sti
 what the run holds afterwards (the model, the backend's state, the observables) is less than those temporaries.
 The estimate counts those arrays from the code, plus what the process holds already (the interpreter, numpy, numba)
 and what loading the compiled kernels adds (measured, :data:`KERNEL_BYTES`); it is a lower bound, 6-14 % under the
-peak measured at N = 9 to 1458 on two kinds of x86-64 CPU (docs/fem.md).
+peak measured at N = 9 to 1458 on three machines (docs/fem.md).
 """
 
 from ..machine_memory import process_memory, resident_memory, size_text
