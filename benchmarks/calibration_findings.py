@@ -30,7 +30,8 @@ them: the root mean square of the seeds' own errors over ``sqrt(k)``):
    the paper's estimator on the aging interface's waiting times with the control's drops;
 8. the pre-check of the decisive drive: std ln T_a per interface, its robust spread, the share of the loading that
    other slips take, against the criteria, per N, Phi and n; the go/no-go;
-9. the cost: CPU seconds of every simulation and the wall time of the events jobs, per study;
+9. the cost: CPU seconds of every simulation (and its wall seconds per increment once slipping, from its log) and
+   the wall time of the events jobs, per study;
 10. the cost of the configs not run here (:data:`PLANNED`) from the CPU seconds per increment and per hold state
     measured here.
 """
@@ -608,12 +609,15 @@ def cost_summary(studies, runs):
             start = _resumed_at(study, path.parent.name, path.stem)
             rows.append((label.get(path.stem, path.parent.name) + (f", resumed at increment {start}: the CPU of "
                                                                    "its last part" if start else ""),
-                         float(table["cpu_time"].iloc[-1]), float(table["s"].iloc[-1])))
+                         float(table["cpu_time"].iloc[-1]), float(table["s"].iloc[-1]),
+                         slipping_pace(study, path.parent.name, path.stem)))
         if not rows:
             continue
         print(f"- {study}: {len(rows)} simulations, {sum(r[1] for r in rows) / 60:.0f} CPU-min")
-        for name, cpu, wall in sorted(rows):
-            print(f"  {name}: {cpu:.0f} CPU-s ({wall:.0f} s)")
+        for name, cpu, wall, pace in sorted(rows):
+            print(f"  {name}: {cpu:.0f} CPU-s ({wall:.0f} s)" + (
+                f"; once slipping {pace[0]:.3g} s per increment (increments {pace[1]}-{pace[2]}, wall, its log)"
+                if pace else ""))
         events = sorted(Path(study, "logs", "benchmarks", "events").glob("*/*/*.tsv"))
         for path in events:
             table = pd.read_csv(path, sep="\t")
@@ -671,6 +675,33 @@ def _resumed_at(study, solver, run):
         return 0
     match = re.search(r"fem increments: (\d+)/", text[text.rindex("resuming from"):])
     return int(match.group(1)) if match else 0
+
+
+def slipping_pace(study, solver, run):
+    """The wall seconds per increment of a simulation once its interfaces slip, from its log's progress lines.
+
+    A run's first increments load it to its first slip and cost a fraction of a slipping increment; a short run's
+    mean CPU time per increment understates what a long one costs. Reads the part of the log after its last resume.
+
+    Returns
+    -------
+    tuple or None
+        (seconds per increment, the increment of the first progress line with a slip, the last increment), or None
+        where the log has fewer than two progress lines after its first slip.
+    """
+    log = Path(study, "logs", "sim", solver, f"{run}.log")
+    if not log.exists():
+        return None
+    text = log.read_text()
+    text = text[text.rindex("resuming from"):] if "resuming from" in text else text
+    progress = [(int(inc), sum(int(v) * 60 ** k for k, v in enumerate(reversed(elapsed.split(":")))), int(slips))
+                for inc, elapsed, slips in re.findall(
+                    r"fem increments: (\d+)/\d+ increment .*?\[([\d:]+) elapsed.*?slips (\d+)\]", text)]
+    slipping = [(inc, seconds) for inc, seconds, slips in progress if slips > 0]
+    if len(slipping) < 2 or slipping[-1][0] == slipping[0][0]:
+        return None
+    (first, start), (last, end) = slipping[0], slipping[-1]
+    return (end - start) / (last - first), first, last
 
 
 def per_increment(runs):
