@@ -667,14 +667,30 @@ def _cpu(study, kind, run):
     return float(pd.read_csv(paths[0], sep="\t")["cpu_time"].iloc[-1]) if paths else math.nan
 
 
-def _resumed_at(study, solver, run):
-    """The increment a simulation's last job resumed at (0 if it ran whole), from its log."""
+def _last_job_progress(study, solver, run):
+    """A simulation's progress lines in its log since its last job started (its last resume, if any).
+
+    Returns
+    -------
+    resumed : bool
+        Whether the last job resumed a partial run.
+    progress : list of tuple
+        (increment, elapsed wall seconds of the job, slips so far) per progress line, in the log's order.
+    """
     log = Path(study, "logs", "sim", solver, f"{run}.log")
     text = log.read_text() if log.exists() else ""
-    if "resuming from" not in text:
-        return 0
-    match = re.search(r"fem increments: (\d+)/", text[text.rindex("resuming from"):])
-    return int(match.group(1)) if match else 0
+    resumed = "resuming from" in text
+    text = text[text.rindex("resuming from"):] if resumed else text
+    progress = [(int(inc), sum(int(v) * 60 ** k for k, v in enumerate(reversed(elapsed.split(":")))), int(slips))
+                for inc, elapsed, slips in re.findall(
+                    r"fem increments: (\d+)/\d+ increment .*?\[([\d:]+) elapsed.*?slips (\d+)\]", text)]
+    return resumed, progress
+
+
+def _resumed_at(study, solver, run):
+    """The increment a simulation's last job resumed at (0 if it ran whole), from its log."""
+    resumed, progress = _last_job_progress(study, solver, run)
+    return progress[0][0] if resumed and progress else 0
 
 
 def slipping_pace(study, solver, run):
@@ -689,19 +705,13 @@ def slipping_pace(study, solver, run):
         (seconds per increment, the increment of the first progress line with a slip, the last increment), or None
         where the log has fewer than two progress lines after its first slip.
     """
-    log = Path(study, "logs", "sim", solver, f"{run}.log")
-    if not log.exists():
-        return None
-    text = log.read_text()
-    text = text[text.rindex("resuming from"):] if "resuming from" in text else text
-    progress = [(int(inc), sum(int(v) * 60 ** k for k, v in enumerate(reversed(elapsed.split(":")))), int(slips))
-                for inc, elapsed, slips in re.findall(
-                    r"fem increments: (\d+)/\d+ increment .*?\[([\d:]+) elapsed.*?slips (\d+)\]", text)]
-    slipping = [(inc, seconds) for inc, seconds, slips in progress if slips > 0]
+    slipping = [(inc, seconds) for inc, seconds, slips in _last_job_progress(study, solver, run)[1] if slips > 0]
     if len(slipping) < 2 or slipping[-1][0] == slipping[0][0]:
         return None
     (first, start), (last, end) = slipping[0], slipping[-1]
     return (end - start) / (last - first), first, last
+
+
 
 
 def per_increment(runs):

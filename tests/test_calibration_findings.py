@@ -41,6 +41,8 @@ def test_a_resumed_run_is_paced_by_its_last_part_and_a_run_without_slips_has_non
     after = [progress(150, 300, 0, 20), progress(200, 300, 50, 25), progress(300, 300, 150, 40)]
     study = write_log(tmp_path, "\r".join(before) + "\nresuming from partial/run.h5\n" + "\r".join(after) + "\n")
     assert calibration_findings.slipping_pace(study, "fem", "run") == (1.0, 150, 300)
+    assert calibration_findings._resumed_at(study, "fem", "run") == 150
     study = write_log(tmp_path / "quiet", "\r".join(progress(i, 300, i, 0) for i in range(0, 301, 100)) + "\n")
     assert calibration_findings.slipping_pace(study, "fem", "run") is None
+    assert calibration_findings._resumed_at(study, "fem", "run") == 0
     assert calibration_findings.slipping_pace(tmp_path / "missing", "fem", "run") is None
